@@ -1,0 +1,603 @@
+"""The raw MIT Push Dataset file layout (Yu et al., IROS 2016): writer, reader and cleaning.
+
+Layout: ``<root>/<surface>/<object>/`` holds one HDF5 file per push, named
+
+    motion_surface=<surface>_shape=<object>_a=<acc>_v=<vel>_i=<side>_s=<point>_t=<angle>[_rep=<NNNN>].h5
+
+with the pusher acceleration ``a`` in mm/s², velocity ``v`` in mm/s, the index ``i`` of the object side that is
+pushed, the contact point ``s`` on that side in 0..1 and the push angle ``t`` to the side's normal in rad. Each
+file holds three datasets of float64 rows, in s, m, rad, N and N·m:
+
+    tip_pose     [N, 4]  [t, x, y, yaw]      pusher tip pose
+    object_pose  [M, 4]  [t, x, y, yaw]      object pose (tracked object frame)
+    ft_wrench    [K, 4]  [t, fx, fy, torque] force-torque sensor reading
+
+The streams are not synchronised, may hold duplicate time stamps, unsorted rows and yaw jumps of 2π, and are
+recorded at about 250 Hz. ``read_raw_push`` returns them as stored; ``load_push`` cleans them the way the
+dataset's own preprocessing does and resamples them onto one clock. Files written by the pushjax testbed may
+carry extra HDF5 file attributes (e.g. ``pushjax_effects``, a JSON string declaring the physical effects
+injected in simulation).
+"""
+
+from __future__ import annotations
+
+import collections
+import dataclasses
+import json
+import math
+import os
+import re
+from collections.abc import Collection, Iterator, Mapping
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+from absl import logging
+
+POSE_DATASETS = ("tip_pose", "object_pose")
+WRENCH_DATASET = "ft_wrench"
+DATASETS = (*POSE_DATASETS, WRENCH_DATASET)
+EFFECTS_ATTRIBUTE = "pushjax_effects"
+DEFAULT_FREQUENCY = 250.0  # Hz, the dataset's recording rate.
+
+# Oldest format that holds everything we write, so old readers open the files; a fixed value keeps bytes stable.
+_LIBVER = ("earliest", "v110")
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_FILE_NAME = re.compile(
+    rf"motion_surface=(?P<surface>[^_=/]+)_shape=(?P<shape>[^_=/]+)"
+    rf"_a=(?P<acceleration>{_NUMBER})_v=(?P<velocity>{_NUMBER})"
+    rf"_i=(?P<side>{_NUMBER})_s=(?P<point>{_NUMBER})_t=(?P<angle>{_NUMBER})"
+    rf"(?:_rep=(?P<repetition>\d+))?\.h5"
+)
+_FILE_NAME_TEMPLATE = (
+    "motion_surface=<surface>_shape=<object>_a=<acc>_v=<vel>_i=<side>_s=<point>_t=<angle>[_rep=<NNNN>].h5"
+)
+_UNPARSEABLE_NAME = "unparseable file name"
+
+
+class PushFileError(ValueError):
+    """A push file that cannot be used; the message names the file.
+
+    Attributes:
+      path: the offending file.
+      reason: a short category (e.g. ``"unreadable file"``, ``"missing dataset"``) used to count skipped files.
+    """
+
+    def __init__(self, path: str | os.PathLike, reason: str, detail: str):
+        super().__init__(f"{os.fspath(path)}: {reason}: {detail}")
+        self.path = Path(path)
+        self.reason = reason
+
+
+@dataclasses.dataclass(frozen=True)
+class PushParams:
+    """The push parameters encoded in a file name, in the file name's units.
+
+    Attributes:
+      surface: support surface material, e.g. ``"abs"``.
+      shape: object name, e.g. ``"rect1"``.
+      acceleration: pusher acceleration, mm/s² (0 = constant velocity).
+      velocity: pusher velocity, mm/s (> 0).
+      side: index of the pushed object side (>= 0).
+      point: contact point along that side, 0..1.
+      angle: push direction relative to the side's inward normal, rad.
+      repetition: repetition number of a repeated push, or None for a single push.
+    """
+
+    surface: str
+    shape: str
+    acceleration: float
+    velocity: float
+    side: int
+    point: float
+    angle: float
+    repetition: int | None = None
+
+    def __post_init__(self):
+        for field in ("surface", "shape"):
+            value = getattr(self, field)
+            if not isinstance(value, str) or not value or re.search(r"[_=/\\]", value):
+                raise ValueError(f"{field} must be a non-empty name without '_', '=', '/' or '\\', got {value!r}")
+        if not isinstance(self.side, (int, np.integer)) or isinstance(self.side, bool) or self.side < 0:
+            raise ValueError(f"side must be an integer >= 0, got {self.side!r}")
+        for field in ("acceleration", "velocity", "point", "angle"):
+            if not math.isfinite(getattr(self, field)):
+                raise ValueError(f"{field} must be finite, got {getattr(self, field)!r}")
+        if self.velocity <= 0:
+            raise ValueError(f"velocity must be > 0 mm/s, got {self.velocity!r}")
+        if not 0.0 <= self.point <= 1.0:
+            raise ValueError(f"point must lie in [0, 1], got {self.point!r}")
+        if self.repetition is not None and (
+            not isinstance(self.repetition, (int, np.integer)) or isinstance(self.repetition, bool)
+            or self.repetition < 0
+        ):
+            raise ValueError(f"repetition must be None or an integer >= 0, got {self.repetition!r}")
+        # Plain Python numbers, so equal parameters compare, hash and print alike whatever types came in.
+        for field in ("acceleration", "velocity", "point", "angle"):
+            object.__setattr__(self, field, float(getattr(self, field)))
+        object.__setattr__(self, "side", int(self.side))
+        if self.repetition is not None:
+            object.__setattr__(self, "repetition", int(self.repetition))
+
+    @property
+    def velocity_si(self) -> float:
+        """Pusher velocity in m/s."""
+        return self.velocity * 1e-3
+
+    @property
+    def acceleration_si(self) -> float:
+        """Pusher acceleration in m/s²."""
+        return self.acceleration * 1e-3
+
+
+def _format_integral(value: float) -> str:
+    """Integers as the dataset writes them ("20"); other values in Python's shortest round-trip form."""
+    return str(int(value)) if float(value).is_integer() else repr(float(value))
+
+
+def _format_3_decimals(value: float) -> str:
+    text = f"{value:.3f}"
+    return "0.000" if text == "-0.000" else text
+
+
+def push_file_name(params: PushParams) -> str:
+    """The canonical file name of a push, formatted as in the real dataset.
+
+    ``a`` and ``v`` are written as integers when integral; ``i``, ``s`` and ``t`` with 3 decimals (``s`` and
+    ``t`` are therefore rounded to 1e-3, as in the dataset); ``rep`` with 4 digits.
+    """
+    name = (
+        f"motion_surface={params.surface}_shape={params.shape}"
+        f"_a={_format_integral(params.acceleration)}_v={_format_integral(params.velocity)}"
+        f"_i={params.side:.3f}_s={_format_3_decimals(params.point)}_t={_format_3_decimals(params.angle)}"
+    )
+    if params.repetition is not None:
+        name += f"_rep={params.repetition:04d}"
+    return name + ".h5"
+
+
+def parse_push_file_name(name: str | os.PathLike) -> PushParams:
+    """Parses a push file name (or a path to one; only its last component is read).
+
+    Numbers may use any decimal or exponent formatting; the side index must be integral.
+
+    Raises:
+      PushFileError (a ValueError) naming the file if the name does not follow the layout.
+    """
+    file_name = Path(name).name
+    match = _FILE_NAME.fullmatch(file_name)
+    if match is None:
+        raise PushFileError(name, _UNPARSEABLE_NAME, f"expected a name like {_FILE_NAME_TEMPLATE}")
+    fields = match.groupdict()
+    side = float(fields["side"])
+    if not side.is_integer():
+        raise PushFileError(name, _UNPARSEABLE_NAME, f"side index i={fields['side']} is not an integer")
+    repetition = fields["repetition"]
+    try:
+        return PushParams(
+            surface=fields["surface"],
+            shape=fields["shape"],
+            acceleration=float(fields["acceleration"]),
+            velocity=float(fields["velocity"]),
+            side=int(side),
+            point=float(fields["point"]),
+            angle=float(fields["angle"]),
+            repetition=None if repetition is None else int(repetition),
+        )
+    except ValueError as error:
+        raise PushFileError(name, _UNPARSEABLE_NAME, str(error)) from error
+
+
+def push_file_path(root: str | os.PathLike, params: PushParams) -> Path:
+    """``<root>/<surface>/<object>/<canonical file name>``."""
+    return Path(root) / params.surface / params.shape / push_file_name(params)
+
+
+def _validated_stream(path: str | os.PathLike, name: str, stream: Any) -> np.ndarray:
+    """A read-only float64 [N, 4] copy of one stream; PushFileError naming ``path`` if unusable."""
+    try:
+        array = np.array(stream, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        raise PushFileError(path, "not numeric", f"{name} is not numeric: {error}") from error
+    if array.ndim != 2 or array.shape[1] != 4:
+        raise PushFileError(path, "wrong shape", f"{name} must have shape [N, 4], got {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise PushFileError(path, "non-finite values", f"{name} holds NaN or infinite values")
+    if np.unique(array[:, 0]).size < 2:
+        raise PushFileError(path, "too few time stamps", f"{name} has fewer than 2 distinct time stamps")
+    array.setflags(write=False)
+    return array
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class RawPush:
+    """One push file's content as stored: no cleaning, only validation.
+
+    Attributes:
+      path: the file.
+      params: parameters parsed from the file name, or None if the name does not follow the layout.
+      tip_pose: [N, 4] rows [t s, x m, y m, yaw rad], read-only.
+      object_pose: [M, 4] rows [t s, x m, y m, yaw rad], read-only.
+      ft_wrench: [K, 4] rows [t s, fx N, fy N, torque N·m], read-only.
+      attributes: the HDF5 file attributes, by name (empty for real dataset files).
+    """
+
+    path: Path
+    params: PushParams | None
+    tip_pose: np.ndarray
+    object_pose: np.ndarray
+    ft_wrench: np.ndarray
+    attributes: Mapping[str, Any] = dataclasses.field(default_factory=dict)
+
+    def __post_init__(self):
+        object.__setattr__(self, "path", Path(self.path))
+        for name in DATASETS:
+            object.__setattr__(self, name, _validated_stream(self.path, name, getattr(self, name)))
+
+    @property
+    def declared_effects(self) -> Any:
+        """The decoded ``pushjax_effects`` JSON attribute, or None when the file declares none."""
+        return _decode_effects(self.path, self.attributes)
+
+
+def _decode_effects(path: Path, attributes: Mapping[str, Any]) -> Any:
+    if EFFECTS_ATTRIBUTE not in attributes:
+        return None
+    try:
+        return json.loads(attributes[EFFECTS_ATTRIBUTE])
+    except (TypeError, json.JSONDecodeError) as error:
+        raise PushFileError(path, "bad attribute", f"{EFFECTS_ATTRIBUTE} is not a JSON string: {error}") from error
+
+
+def _validated_attribute(name: Any, value: Any) -> Any:
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"attribute names must be non-empty strings, got {name!r}")
+    if isinstance(value, (str, bool, int, float, np.bool_, np.integer, np.floating)):
+        return value
+    if isinstance(value, np.ndarray) and value.dtype.kind in "biuf":
+        return value
+    raise ValueError(
+        f"attribute {name!r} must be a str, bool, int, float or numeric numpy array, got {type(value).__name__}"
+    )
+
+
+def write_push(
+    path: str | os.PathLike,
+    params: PushParams | None,
+    tip_pose: Any,
+    object_pose: Any,
+    ft_wrench: Any,
+    attributes: Mapping[str, Any] | None = None,
+) -> Path:
+    """Writes one push file in the dataset's layout, deterministically (same inputs, same bytes).
+
+    The file is written next to ``path`` and then renamed, so an interrupted write leaves no truncated ``.h5``.
+    Parent directories are created.
+
+    Args:
+      path: the file to write.
+      params: if given, ``path``'s file name must be ``push_file_name(params)``; None writes any name.
+      tip_pose: [N, 4] rows [t s, x m, y m, yaw rad].
+      object_pose: [M, 4] rows [t s, x m, y m, yaw rad].
+      ft_wrench: [K, 4] rows [t s, fx N, fy N, torque N·m].
+      attributes: extra HDF5 file attributes (str, bool, int, float or numeric array values), written in name
+        order; None writes nothing extra, so the file holds exactly what a real dataset file holds.
+
+    Returns:
+      ``path`` as a Path.
+
+    Raises:
+      ValueError: a stream that is not [N, 4], holds NaN/inf or fewer than 2 distinct time stamps; a file name
+        that does not match ``params``; an unsupported attribute.
+    """
+    path = Path(path)
+    if params is not None and path.name != push_file_name(params):
+        raise ValueError(f"path {str(path)!r} does not end in the file name of params, {push_file_name(params)!r}")
+    streams = {name: _validated_stream(path, name, stream)
+               for name, stream in zip(DATASETS, (tip_pose, object_pose, ft_wrench))}
+    attributes = {} if attributes is None else attributes
+    checked_attributes = {name: _validated_attribute(name, attributes[name]) for name in sorted(attributes)}
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(path.name + ".partial")
+    try:
+        with h5py.File(partial, "w", libver=_LIBVER) as file:
+            for name, stream in streams.items():
+                file.create_dataset(name, data=stream, dtype="<f8", track_times=False)
+            for name, value in checked_attributes.items():
+                file.attrs[name] = value
+        os.replace(partial, path)
+    finally:
+        partial.unlink(missing_ok=True)
+    return path
+
+
+def _attribute_value(value: Any) -> Any:
+    if isinstance(value, bytes):
+        return value.decode("utf-8")
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def read_raw_push(path: str | os.PathLike) -> RawPush:
+    """Reads one push file as stored (no cleaning).
+
+    Raises:
+      FileNotFoundError: no file at ``path``.
+      PushFileError (a ValueError) naming the file: corrupt or truncated file, missing dataset, a stream not
+        [N, 4], NaN/inf values, or fewer than 2 distinct time stamps in a stream.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no push file at {str(path)!r}")
+    try:
+        params = parse_push_file_name(path)
+    except PushFileError:
+        params = None
+    try:
+        with h5py.File(path, "r") as file:
+            streams = {}
+            for name in DATASETS:
+                dataset = file.get(name)
+                if not isinstance(dataset, h5py.Dataset):
+                    raise PushFileError(path, "missing dataset", f"no dataset {name!r}")
+                streams[name] = dataset[()]
+            attributes = {name: _attribute_value(file.attrs[name]) for name in sorted(file.attrs)}
+    except PushFileError:
+        raise
+    except (OSError, RuntimeError, KeyError, TypeError, ValueError) as error:
+        # h5py reports damage in headers or attributes through any of these.
+        raise PushFileError(path, "unreadable file", f"corrupt or truncated HDF5 file ({error})") from error
+    return RawPush(path=path, params=params, attributes=attributes, **streams)
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Push:
+    """One cleaned push, all streams on one clock.
+
+    Attributes:
+      path: the file it was read from.
+      params: parameters parsed from the file name, or None if the name does not follow the layout.
+      time: [T] s, starting at 0, spaced 1 / frequency.
+      tip: [T, 3] pusher tip pose (x m, y m, yaw rad); yaw unwrapped (continuous, not wrapped to [-π, π]).
+      object: [T, 3] object pose (x m, y m, yaw rad); yaw unwrapped.
+      wrench: [T, 3] (fx N, fy N, torque N·m).
+      attributes: the HDF5 file attributes, by name.
+    """
+
+    path: Path
+    params: PushParams | None
+    time: np.ndarray
+    tip: np.ndarray
+    object: np.ndarray
+    wrench: np.ndarray
+    attributes: Mapping[str, Any]
+
+    @property
+    def declared_effects(self) -> Any:
+        """The decoded ``pushjax_effects`` JSON attribute, or None when the file declares none."""
+        return _decode_effects(self.path, self.attributes)
+
+
+def _clean_stream(stream: np.ndarray, unwrap_yaw: bool) -> np.ndarray:
+    """Drops rows with an already-seen time stamp (keeping the first in file order), sorts by time and
+    optionally unwraps the yaw column (index 3)."""
+    _, first_rows = np.unique(stream[:, 0], return_index=True)
+    cleaned = stream[first_rows]  # np.unique sorts by time stamp.
+    if unwrap_yaw:
+        cleaned[:, 3] = np.unwrap(cleaned[:, 3])
+    return cleaned
+
+
+def _rotation(yaw: float) -> np.ndarray:
+    cos, sin = math.cos(yaw), math.sin(yaw)
+    return np.array([[cos, -sin], [sin, cos]])
+
+
+def _check_frequency(frequency: float) -> None:
+    if not (isinstance(frequency, (int, float, np.integer, np.floating)) and math.isfinite(frequency)
+            and frequency > 0):
+        raise ValueError(f"frequency must be a positive number of Hz, got {frequency!r}")
+
+
+def clean_push(raw: RawPush, frequency: float = DEFAULT_FREQUENCY, zero_initial_pose: bool = False) -> Push:
+    """Cleans the streams of a raw push and resamples them onto one clock.
+
+    Per stream: rows repeating an earlier time stamp are dropped (the first in file order is kept), rows are
+    sorted by time, and the yaw of the two pose streams is unwrapped. All streams are then linearly
+    interpolated onto ``t0 + k / frequency`` for ``t0 <= t <= t1``, where ``[t0, t1]`` is the overlap of the
+    three streams' time ranges; the returned time is shifted to start at 0.
+
+    Args:
+      raw: the push as stored.
+      frequency: rate of the common clock, Hz (> 0).
+      zero_initial_pose: express tip and object poses in the object's initial frame (object starts at the
+        origin with yaw 0) and rotate the wrench's force into that frame; the torque about the vertical axis is
+        unchanged by the rotation.
+
+    Raises:
+      ValueError: a non-positive frequency.
+      PushFileError (a ValueError) naming the file: the streams' time ranges overlap on fewer than 2 samples.
+    """
+    _check_frequency(frequency)
+    streams = {name: _clean_stream(getattr(raw, name), unwrap_yaw=name in POSE_DATASETS) for name in DATASETS}
+    start = max(stream[0, 0] for stream in streams.values())
+    end = min(stream[-1, 0] for stream in streams.values())
+    # The tolerance keeps a sample that lands on `end` up to rounding.
+    n_samples = math.floor((end - start) * frequency + 1e-9) + 1 if end >= start else 0
+    if n_samples < 2:
+        raise PushFileError(
+            raw.path, "no time overlap",
+            f"streams overlap on [{start:.6f}, {end:.6f}] s, fewer than 2 samples at {frequency} Hz",
+        )
+    time = np.arange(n_samples) / frequency
+    query = np.minimum(start + time, end)
+    tip, object_pose, wrench = (
+        np.stack([np.interp(query, stream[:, 0], stream[:, column]) for column in (1, 2, 3)], axis=-1)
+        for stream in streams.values()
+    )
+    if zero_initial_pose:
+        origin, yaw0 = object_pose[0, :2].copy(), object_pose[0, 2]
+        to_object_frame = _rotation(-yaw0)
+        for pose in (tip, object_pose):
+            pose[:, :2] = (pose[:, :2] - origin) @ to_object_frame.T
+            pose[:, 2] -= yaw0
+        wrench[:, :2] = wrench[:, :2] @ to_object_frame.T
+    for array in (time, tip, object_pose, wrench):
+        array.setflags(write=False)
+    return Push(
+        path=raw.path, params=raw.params, time=time, tip=tip, object=object_pose, wrench=wrench,
+        attributes=raw.attributes,
+    )
+
+
+def load_push(
+    path: str | os.PathLike, frequency: float = DEFAULT_FREQUENCY, zero_initial_pose: bool = False
+) -> Push:
+    """Reads one push file and cleans it: ``clean_push(read_raw_push(path), frequency, zero_initial_pose)``."""
+    return clean_push(read_raw_push(path), frequency=frequency, zero_initial_pose=zero_initial_pose)
+
+
+def _matches(value: float, targets: tuple[float, ...] | None) -> bool:
+    return targets is None or any(math.isclose(value, target, rel_tol=1e-9, abs_tol=1e-6) for target in targets)
+
+
+def _as_name_set(argument: str, names: Collection[str] | None) -> frozenset[str] | None:
+    if names is None:
+        return None
+    if isinstance(names, str):
+        raise ValueError(f"{argument} must be a collection of names, not the single string {names!r}")
+    return frozenset(names)
+
+
+def _as_number_tuple(argument: str, values: Collection[float] | None) -> tuple[float, ...] | None:
+    if values is None:
+        return None
+    numbers = tuple(float(value) for value in values)
+    if not all(math.isfinite(number) for number in numbers):
+        raise ValueError(f"{argument} must hold finite numbers, got {values!r}")
+    return numbers
+
+
+class PushIterator:
+    """Iterable over the cleaned pushes below a dataset root, reporting every file it does not yield.
+
+    The file list is fixed at construction (sorted, so iteration order is deterministic). Files whose name does
+    not parse are skipped under ``"unparseable file name"``; files that fail to load are skipped under their
+    ``PushFileError.reason``. Files not ending in ``.h5`` are ignored, and files excluded by the filters are
+    counted in ``n_filtered``. ``skipped`` reflects the latest pass; after each (complete or abandoned) pass a
+    summary is logged with absl.logging.
+    """
+
+    def __init__(
+        self,
+        root: str | os.PathLike,
+        objects: Collection[str] | None = None,
+        surfaces: Collection[str] | None = None,
+        velocities: Collection[float] | None = None,
+        accelerations: Collection[float] | None = None,
+        frequency: float = DEFAULT_FREQUENCY,
+        zero_initial_pose: bool = False,
+    ):
+        self.root = Path(root)
+        if not self.root.is_dir():
+            raise ValueError(f"root {str(self.root)!r} is not a directory")
+        _check_frequency(frequency)
+        self.frequency = frequency
+        self.zero_initial_pose = zero_initial_pose
+        objects = _as_name_set("objects", objects)
+        surfaces = _as_name_set("surfaces", surfaces)
+        velocities = _as_number_tuple("velocities", velocities)
+        accelerations = _as_number_tuple("accelerations", accelerations)
+
+        self.paths: list[Path] = []
+        self.n_filtered = 0
+        self._unparseable: list[Path] = []
+        candidates = sorted(
+            (path for path in self.root.rglob("*.h5") if path.is_file()),
+            key=lambda path: path.relative_to(self.root).as_posix(),
+        )
+        for path in candidates:
+            try:
+                params = parse_push_file_name(path)
+            except PushFileError:
+                self._unparseable.append(path)
+                continue
+            if (
+                (objects is None or params.shape in objects)
+                and (surfaces is None or params.surface in surfaces)
+                and _matches(params.velocity, velocities)
+                and _matches(params.acceleration, accelerations)
+            ):
+                self.paths.append(path)
+            else:
+                self.n_filtered += 1
+        self._unloadable: dict[str, list[Path]] = {}
+        self.n_yielded = 0
+
+    def __iter__(self) -> Iterator[Push]:
+        self._unloadable = collections.defaultdict(list)
+        self.n_yielded = 0
+        try:
+            for path in self.paths:
+                try:
+                    push = load_push(path, frequency=self.frequency, zero_initial_pose=self.zero_initial_pose)
+                except PushFileError as error:
+                    self._unloadable[error.reason].append(path)
+                    continue
+                self.n_yielded += 1
+                yield push
+        finally:
+            (logging.warning if self.n_skipped else logging.info)("%s", self.summary())
+
+    @property
+    def skipped(self) -> dict[str, list[Path]]:
+        """Skipped files by reason (sorted by reason), for the latest pass."""
+        skipped = dict(self._unloadable)
+        if self._unparseable:
+            skipped[_UNPARSEABLE_NAME] = list(self._unparseable)
+        return {reason: skipped[reason] for reason in sorted(skipped)}
+
+    @property
+    def n_skipped(self) -> int:
+        return sum(len(paths) for paths in self.skipped.values())
+
+    def summary(self) -> str:
+        """One line: pushes yielded, files filtered out, files skipped (count per reason)."""
+        reasons = ", ".join(f"{reason}: {len(paths)}" for reason, paths in self.skipped.items())
+        return (
+            f"MIT push files under {str(self.root)!r}: {self.n_yielded} pushes yielded, "
+            f"{self.n_filtered} filtered out, {self.n_skipped} skipped" + (f" ({reasons})" if reasons else "")
+        )
+
+
+def iter_pushes(
+    root: str | os.PathLike,
+    objects: Collection[str] | None = None,
+    surfaces: Collection[str] | None = None,
+    velocities: Collection[float] | None = None,
+    accelerations: Collection[float] | None = None,
+    frequency: float = DEFAULT_FREQUENCY,
+    zero_initial_pose: bool = False,
+) -> PushIterator:
+    """The cleaned pushes of every ``*.h5`` file below ``root`` (any depth), in sorted path order.
+
+    Args:
+      root: dataset root directory, laid out as ``<root>/<surface>/<object>/<file>.h5``.
+      objects: object names to keep (e.g. ``{"rect1"}``), or None for all.
+      surfaces: surface names to keep (e.g. ``{"abs"}``), or None for all.
+      velocities: pusher velocities to keep, mm/s (compared with 1e-6 tolerance), or None for all.
+      accelerations: pusher accelerations to keep, mm/s² (compared with 1e-6 tolerance), or None for all.
+      frequency: rate of each push's common clock, Hz.
+      zero_initial_pose: see ``clean_push``.
+
+    Returns:
+      A ``PushIterator``: iterate it for ``Push`` values; its ``skipped``, ``n_skipped``, ``n_filtered`` and
+      ``summary()`` report the files not yielded. Filters select on the parsed file-name fields.
+    """
+    return PushIterator(
+        root, objects=objects, surfaces=surfaces, velocities=velocities, accelerations=accelerations,
+        frequency=frequency, zero_initial_pose=zero_initial_pose,
+    )

@@ -1,0 +1,68 @@
+"""Cameras (pure JAX) and offscreen MuJoCo depth / point-cloud rendering of the pushing scene.
+
+Importing this package sets `MUJOCO_GL=egl` unless the variable is already set (see `renderer`).
+"""
+
+from pushjax.render.camera import (
+    Camera,
+    bilinear_lookup,
+    camera_to_world,
+    field_of_view_deg,
+    free_camera,
+    intrinsics_from_fov,
+    look_at,
+    pixel_centres,
+    pixels_per_metre_at_table,
+    point_cloud_from_depth,
+    project,
+    top_down_camera,
+    unproject,
+    unproject_to_camera,
+    world_to_camera,
+)
+from pushjax.render.renderer import (
+    CAMERA,
+    OBJECT_BODY,
+    OBJECT_JOINT,
+    PUSHER_BODY,
+    PUSHER_CLEARANCE_M,
+    TABLE_GEOM,
+    DepthRenderer,
+    apply_scene_transform,
+    planar_transform,
+    random_scene_transform,
+    set_camera,
+    transform_planar_points,
+    transform_planar_poses,
+)
+
+__all__ = [
+    "Camera",
+    "bilinear_lookup",
+    "camera_to_world",
+    "field_of_view_deg",
+    "free_camera",
+    "intrinsics_from_fov",
+    "look_at",
+    "pixel_centres",
+    "pixels_per_metre_at_table",
+    "point_cloud_from_depth",
+    "project",
+    "top_down_camera",
+    "unproject",
+    "unproject_to_camera",
+    "world_to_camera",
+    "CAMERA",
+    "OBJECT_BODY",
+    "OBJECT_JOINT",
+    "PUSHER_BODY",
+    "PUSHER_CLEARANCE_M",
+    "TABLE_GEOM",
+    "DepthRenderer",
+    "apply_scene_transform",
+    "planar_transform",
+    "random_scene_transform",
+    "set_camera",
+    "transform_planar_points",
+    "transform_planar_poses",
+]
