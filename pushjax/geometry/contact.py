@@ -34,9 +34,9 @@ goal (>= 1e5 annotations in <= 10 s on 2 CPU cores) is met by NumPy; see ``bench
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 
-import flax.struct
 import numpy as np
 import shapely
 
@@ -58,7 +58,7 @@ _DISTANCE_TOLERANCE = 1e-12
 at exactly r (e.g. from ``side_point``) touches regardless of rounding."""
 
 
-@flax.struct.dataclass
+@dataclasses.dataclass(frozen=True)
 class ContactAnnotation:
     """Contact annotation of a batch of pushes, batch shape ``[...]`` (NumPy arrays, world axes).
 

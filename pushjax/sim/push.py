@@ -1,0 +1,353 @@
+"""Simulated pushes following the MIT Push Dataset protocol, recorded in the dataset's raw layout.
+
+Protocol (Yu et al., IROS 2016; the collection script ``collect_push_dataset_with_acceleration.py`` in
+``github.com/mcubelab/push-est-public``): the pusher touches side ``i`` of the object at the fraction ``s`` of
+its length (the pusher centre one pusher radius out along the side's normal) and moves in the direction of the
+side's inward normal turned by the angle ``t`` (counter-clockwise positive), either at constant velocity ``v``
+(``a = 0``) or accelerating from rest at ``a``, until it has travelled 5 cm past the contact point. Here the
+pusher starts 3 mm before that contact point (along the push direction), at velocity ``v`` for constant-velocity
+pushes (the robot reaches it within 0.2 mm at the dataset's 100 m/s²) and at rest for accelerating ones, which
+accelerate up to ``v`` (the MIT robot capped them at 1 m/s). When the pusher stops, recording goes on for 0.5 s
+so that any sliding after the push is recorded.
+
+Recording (250 Hz, one clock, ``t`` from 0 at the start of the pusher's motion):
+
+* ``tip_pose`` [t, x, y, 0]: the simulated pusher tip's centre (m; the tip does not turn).
+* ``object_pose`` [t, x, y, yaw]: the object's tracked frame (m, rad in (-π, π]), after the tracking effects.
+* ``ft_wrench`` [t, fx, fy, torque]: the force (N) that the pusher applies to the object, world axes, and its
+  moment (N·m) about the pusher's axis, which only pusher–object friction makes non-zero; both averaged over the
+  4 ms before ``t`` like a low-pass filtered force-torque sensor (the sample at ``t = 0`` is instantaneous).
+
+Simulation: MuJoCo scenes from :mod:`pushjax.sim.scene`, whose pusher is a servo-driven carriage (MuJoCo's mocap
+bodies have no velocity, so contacts with them lag behind; the mocap body ``pusher`` only mirrors the commanded
+position for rendering). The servo tracks the commanded position and velocity; the recorded tip pose is the
+simulated one. The time step is ``4 ms / n`` with the smallest ``n >= 2`` for which the pusher advances at most
+0.1 mm per step (2 ms up to 50 mm/s, 0.2 ms at 500 mm/s). Before any push the object settles on the table for
+0.3 s (with gravity normal to the table); every push starts from that settled state, placed at the requested
+pose, with a zero solver warm start, so a push's result does not depend on the pushes simulated before it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from collections.abc import Sequence
+
+import mujoco
+import numpy as np
+from mujoco import rollout
+
+from pushjax.data.mit_push import PushParams
+from pushjax.geometry.objects import PUSHER_RADIUS, PushObject, get_object
+from pushjax.sim import scene
+from pushjax.sim.effects import Effects
+
+SAMPLE_RATE = 250.0
+"""Recording rate in Hz."""
+SAMPLE_PERIOD = 1.0 / SAMPLE_RATE
+PUSH_DISTANCE = 0.05
+"""Pusher travel past the nominal contact point in m."""
+APPROACH_DISTANCE = 0.003
+"""Pusher travel before the nominal contact point in m."""
+POST_PUSH_DURATION = 0.5
+"""Recording time after the pusher stops in s."""
+SETTLE_DURATION = 0.3
+"""Time the object rests on the table before any push, to seat its support contacts, in s."""
+MAX_STEP_TRAVEL = 1e-4
+"""Largest pusher advance per simulation step in m."""
+MIN_STEPS_PER_SAMPLE = 2
+
+MIT_VELOCITIES = (10.0, 20.0, 50.0, 75.0, 100.0, 150.0, 200.0, 300.0, 400.0, 500.0)
+"""Constant pusher velocities of the MIT grid, mm/s."""
+MIT_ACCELERATIONS = (100.0, 200.0, 500.0, 750.0, 1000.0, 1500.0, 2000.0, 2500.0)
+"""Pusher accelerations of the MIT grid, mm/s² (0 = constant velocity is the other option)."""
+MIT_ANGLES = tuple(np.radians(np.linspace(-80.0, 80.0, 9)))
+"""Push angles of the MIT grid to the side's inward normal, rad (-80° to 80° in 20° steps)."""
+
+_PARKED_PUSHER = np.array([1.0, 1.0])
+"""Where the pusher waits while the object settles, m (far from every object)."""
+
+
+def side_points(obj: PushObject | str) -> np.ndarray:
+    """Contact fractions ``s`` of the MIT grid on each side of ``obj``.
+
+    The collection script pushes polygon sides at ``s`` = 0, 0.1, ..., 1 (it meant to use 0, 0.2, ..., 1 for
+    hex, but its test compares the vertex list with the string "hex", so hex gets the 11 points too) and curved
+    outlines at 40 points evenly spaced around the whole outline; with the outline cut into four quarter sides
+    (see :class:`pushjax.geometry.PushObject`) that is ``s`` = 0, 0.1, ..., 0.9 on each quarter.
+    """
+    if isinstance(obj, str):
+        obj = get_object(obj)
+    if any(len(side) > 2 for side in obj.sides):
+        return np.arange(10) / 10
+    return np.linspace(0.0, 1.0, 11)
+
+
+def sample_push(
+    obj: PushObject | str,
+    surface: str,
+    rng: np.random.Generator,
+    velocities: Sequence[float] = MIT_VELOCITIES,
+    accelerations: Sequence[float] = (0.0,),
+) -> PushParams:
+    """A push drawn uniformly from the MIT grid: side, contact point, angle, velocity and acceleration.
+
+    Args:
+      obj: the object or its name.
+      surface: surface name, stored in the returned parameters.
+      rng: the random generator to draw from.
+      velocities: allowed pusher velocities, mm/s (> 0; for accelerating pushes the top speed).
+      accelerations: allowed pusher accelerations, mm/s² (0 = constant velocity).
+
+    Returns:
+      The push, with ``point`` and ``angle`` rounded to the 3 decimals that the file name keeps, so that the
+      simulated push is exactly the one its file name describes.
+    """
+    if isinstance(obj, str):
+        obj = get_object(obj)
+    if not velocities or not accelerations:
+        raise ValueError("velocities and accelerations: expected at least one value each")
+    return PushParams(
+        surface=surface,
+        shape=obj.name,
+        acceleration=float(rng.choice(np.asarray(accelerations, dtype=np.float64))),
+        velocity=float(rng.choice(np.asarray(velocities, dtype=np.float64))),
+        side=int(rng.integers(len(obj.sides))),
+        point=round(float(rng.choice(side_points(obj))), 3),
+        angle=round(float(rng.choice(MIT_ANGLES)), 3),
+    )
+
+
+def pusher_line(obj: PushObject | str, params: PushParams) -> tuple[np.ndarray, np.ndarray]:
+    """Start point [2] (m, object frame) and unit direction [2] of the pusher centre's straight path."""
+    if isinstance(obj, str):
+        obj = get_object(obj)
+    point, inward = obj.side_point(params.side, params.point)
+    cos, sin = math.cos(params.angle), math.sin(params.angle)
+    direction = np.array([cos * inward[0] - sin * inward[1], sin * inward[0] + cos * inward[1]])
+    contact_centre = point - PUSHER_RADIUS * inward
+    return contact_centre - APPROACH_DISTANCE * direction, direction
+
+
+def pusher_motion(params: PushParams, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distance travelled (m) and speed (m/s) of the pusher at ``times`` [T] (s) since it started."""
+    travel = APPROACH_DISTANCE + PUSH_DISTANCE
+    speed, acceleration = params.velocity_si, params.acceleration_si
+    times = np.asarray(times, dtype=np.float64)
+    if acceleration <= 0:
+        distance = speed * times
+        velocity = np.full_like(times, speed)
+    else:
+        ramp = speed / acceleration
+        distance = np.where(times < ramp, 0.5 * acceleration * times ** 2, 0.5 * acceleration * ramp ** 2
+                            + speed * (times - ramp))
+        velocity = np.minimum(acceleration * times, speed)
+    moving = distance < travel
+    return np.where(moving, distance, travel), np.where(moving, velocity, 0.0)
+
+
+def push_duration(params: PushParams) -> float:
+    """Time in s from the start of the pusher's motion to its stop."""
+    travel = APPROACH_DISTANCE + PUSH_DISTANCE
+    speed, acceleration = params.velocity_si, params.acceleration_si
+    if acceleration <= 0:
+        return travel / speed
+    ramp = speed / acceleration
+    if 0.5 * acceleration * ramp ** 2 >= travel:
+        return math.sqrt(2 * travel / acceleration)
+    return ramp + (travel - 0.5 * acceleration * ramp ** 2) / speed
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Recording:
+    """One recorded push, every stream sampled on the same 250 Hz clock.
+
+    Attributes:
+      params: the push.
+      tip_pose: [N, 4] rows [t s, x m, y m, yaw rad (0)].
+      object_pose: [N, 4] rows [t s, x m, y m, yaw rad] as recorded (with the tracking effects).
+      ft_wrench: [N, 4] rows [t s, fx N, fy N, torque N·m].
+      true_object_pose: [N, 4] the simulated pose of the tracked frame, before the tracking effects.
+    """
+
+    params: PushParams
+    tip_pose: np.ndarray
+    object_pose: np.ndarray
+    ft_wrench: np.ndarray
+    true_object_pose: np.ndarray
+
+
+class Simulator:
+    """Simulates pushes of one object on one surface under fixed effects (one compiled MuJoCo model).
+
+    Args:
+      obj: the object or its name.
+      surface: surface name.
+      effects: the effects; the physical ones shape the model, the tracking ones the recorded poses.
+      support: ``"grid"`` or ``"hull"`` (see :mod:`pushjax.sim.scene`).
+    """
+
+    def __init__(self, obj: PushObject | str, surface: str, effects: Effects = Effects(), support: str = "grid"):
+        self.obj = get_object(obj) if isinstance(obj, str) else obj
+        self.surface = surface
+        self.effects = effects
+        self.support = support
+        self.model = scene.build_model(self.obj, surface, effects, support)
+        self.data = mujoco.MjData(self.model)
+        self._object_qpos = int(self.model.jnt_qposadr[self.model.joint("object_joint").id])
+        self._pusher_qpos = int(self.model.jnt_qposadr[self.model.joint("pusher_x").id])
+        self._pusher_qvel = int(self.model.jnt_dofadr[self.model.joint("pusher_x").id])
+        self._pusher_z = float(self.model.body("pusher").pos[2])
+        self._state_spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        self._control_spec = int(mujoco.mjtState.mjSTATE_CTRL) | int(mujoco.mjtState.mjSTATE_MOCAP_POS)
+        self._settled_object = self._settle()
+
+    def _settle(self) -> np.ndarray:
+        """[7] free-joint qpos of the object resting at the origin (gravity normal to the table)."""
+        model, data = self.model, self.data
+        mujoco.mj_resetData(model, data)
+        tilted_gravity = model.opt.gravity.copy()
+        model.opt.gravity[:] = [0.0, 0.0, -np.linalg.norm(tilted_gravity)]
+        model.opt.timestep = SAMPLE_PERIOD / MIN_STEPS_PER_SAMPLE
+        data.qpos[self._object_qpos + 2] = self.obj.thickness / 2
+        data.qpos[self._pusher_qpos:self._pusher_qpos + 2] = _PARKED_PUSHER
+        data.ctrl[:] = [*_PARKED_PUSHER, 0.0, 0.0]
+        try:
+            mujoco.mj_step(model, data, nstep=round(SETTLE_DURATION / model.opt.timestep))
+        finally:
+            model.opt.gravity[:] = tilted_gravity
+        settled = data.qpos[self._object_qpos:self._object_qpos + 7].copy()
+        settled[:2] = 0.0
+        settled[3:] = _yaw_removed(settled[3:])
+        return settled
+
+    def run(self, params: PushParams, initial_pose: Sequence[float] = (0.0, 0.0, 0.0),
+            rng: np.random.Generator | None = None) -> Recording:
+        """Simulates and records one push.
+
+        Args:
+          params: the push (its ``shape`` must be this simulator's object).
+          initial_pose: (x m, y m, yaw rad) of the object's tracked frame at the start.
+          rng: random generator for the tracking noise; required when ``effects.tracking_noise`` is non-zero.
+
+        Returns:
+          The :class:`Recording`.
+        """
+        if params.shape != self.obj.name:
+            raise ValueError(f"params: shape {params.shape!r} does not match the simulator's object {self.obj.name!r}")
+        if params.side >= len(self.obj.sides):
+            raise ValueError(
+                f"params: side {params.side} out of range, {self.obj.name} has {len(self.obj.sides)} sides")
+        pose = np.asarray(initial_pose, dtype=np.float64)
+        if pose.shape != (3,) or not np.all(np.isfinite(pose)):
+            raise ValueError(f"initial_pose: expected finite (x, y, yaw), got {initial_pose!r}")
+        noisy = any(self.effects.tracking_noise)
+        if noisy and rng is None:
+            raise ValueError("rng: required to draw the tracking noise of these effects")
+
+        model, data = self.model, self.data
+        steps_per_sample = max(MIN_STEPS_PER_SAMPLE,
+                               math.ceil(params.velocity_si * SAMPLE_PERIOD / MAX_STEP_TRAVEL - 1e-9))
+        model.opt.timestep = SAMPLE_PERIOD / steps_per_sample
+        samples = math.ceil((push_duration(params) + POST_PUSH_DURATION) / SAMPLE_PERIOD) + 1
+        nstep = (samples - 1) * steps_per_sample
+
+        rotation = _rotation(pose[2])
+        start_local, direction_local = pusher_line(self.obj, params)
+        start = pose[:2] + rotation @ start_local
+        direction = rotation @ direction_local
+        targets = np.arange(1, nstep + 1) * model.opt.timestep
+        distance, speed = pusher_motion(params, targets)
+        target_xy = start + distance[:, None] * direction
+        control = np.concatenate([
+            target_xy, speed[:, None] * direction, target_xy, np.full((nstep, 1), self._pusher_z)], axis=1)
+
+        mujoco.mj_resetData(model, data)
+        qpos = data.qpos
+        qpos[self._object_qpos:self._object_qpos + 2] = pose[:2] + rotation @ self._settled_object[:2]
+        qpos[self._object_qpos + 2] = self._settled_object[2]
+        quaternion = np.empty(4)
+        mujoco.mju_mulQuat(quaternion, _yaw_quaternion(pose[2]), self._settled_object[3:])
+        qpos[self._object_qpos + 3:self._object_qpos + 7] = quaternion
+        qpos[self._pusher_qpos:self._pusher_qpos + 2] = start
+        data.qvel[self._pusher_qvel:self._pusher_qvel + 2] = pusher_motion(params, np.zeros(1))[1][0] * direction
+        initial_state = np.empty(mujoco.mj_stateSize(model, self._state_spec))
+        mujoco.mj_getState(model, data, initial_state, self._state_spec)
+        states, sensors = rollout.rollout(
+            model, data, initial_state[None], control[None], control_spec=self._control_spec,
+            initial_warmstart=np.zeros((1, model.nv)))
+        states, sensors = states[0], sensors[0]
+
+        # states[k] follows step k; prepend the initial state so that index k is time k * timestep.
+        qpos_path = np.concatenate([initial_state[None, 1:1 + model.nq], states[:, 1:1 + model.nq]])
+        sampled = qpos_path[::steps_per_sample]
+        times = np.arange(samples) * SAMPLE_PERIOD
+        object_qpos = sampled[:, self._object_qpos:self._object_qpos + 7]
+        true_pose = np.column_stack([times, object_qpos[:, :2], _yaw(object_qpos[:, 3:])])
+        tip_pose = np.column_stack([times, sampled[:, self._pusher_qpos:self._pusher_qpos + 2], np.zeros(samples)])
+
+        # sensors[k] is computed at the state of time k * timestep: force, torque (at pos), pos.
+        tip_at_step = qpos_path[:-1, self._pusher_qpos:self._pusher_qpos + 2]
+        force = sensors[:, 0:2]
+        lever = sensors[:, 6:8] - tip_at_step
+        moment = sensors[:, 5] + lever[:, 0] * sensors[:, 1] - lever[:, 1] * sensors[:, 0]
+        wrench = np.column_stack([force, moment])
+        averaged = np.concatenate([wrench[:1], wrench.reshape(samples - 1, steps_per_sample, 3).mean(axis=1)])
+        ft_wrench = np.column_stack([times, averaged])
+
+        recorded = _tracked(true_pose, self.effects, rng if noisy else None)
+        return Recording(params=params, tip_pose=tip_pose, object_pose=recorded, ft_wrench=ft_wrench,
+                         true_object_pose=true_pose)
+
+
+def _tracked(true_pose: np.ndarray, effects: Effects, rng: np.random.Generator | None) -> np.ndarray:
+    """The motion-capture view of [N, 4] poses: marker offset (bias) and i.i.d. Gaussian noise."""
+    dx, dy, dyaw = effects.tracking_bias
+    yaw = true_pose[:, 3]
+    recorded = true_pose.copy()
+    recorded[:, 1] += np.cos(yaw) * dx - np.sin(yaw) * dy
+    recorded[:, 2] += np.sin(yaw) * dx + np.cos(yaw) * dy
+    recorded[:, 3] += dyaw
+    if rng is not None:
+        sigma_xy, sigma_yaw = effects.tracking_noise
+        noise = rng.standard_normal((len(recorded), 3))
+        recorded[:, 1:3] += sigma_xy * noise[:, :2]
+        recorded[:, 3] += sigma_yaw * noise[:, 2]
+    recorded[:, 3] = np.angle(np.exp(1j * recorded[:, 3]))
+    return recorded
+
+
+def _rotation(yaw: float) -> np.ndarray:
+    cos, sin = math.cos(yaw), math.sin(yaw)
+    return np.array([[cos, -sin], [sin, cos]])
+
+
+def _yaw_quaternion(yaw: float) -> np.ndarray:
+    return np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
+
+
+def _yaw(quaternions: np.ndarray) -> np.ndarray:
+    """[N] yaw in (-π, π] of [N, 4] unit quaternions (w, x, y, z)."""
+    w, x, y, z = quaternions.T
+    return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+
+def _yaw_removed(quaternion: np.ndarray) -> np.ndarray:
+    """The quaternion with its yaw turned back to 0 (keeps the small settling tilt)."""
+    result = np.empty(4)
+    mujoco.mju_mulQuat(result, _yaw_quaternion(-float(_yaw(quaternion[None])[0])), quaternion)
+    return result
+
+
+@functools.lru_cache(maxsize=8)
+def simulator(obj: str, surface: str, effects: Effects = Effects(), support: str = "grid") -> Simulator:
+    """A cached :class:`Simulator` (one per object, surface, effects and support in this process)."""
+    return Simulator(obj, surface, effects, support)
+
+
+def simulate_push(params: PushParams, effects: Effects = Effects(), support: str = "grid",
+                  initial_pose: Sequence[float] = (0.0, 0.0, 0.0),
+                  rng: np.random.Generator | None = None) -> Recording:
+    """Simulates one push (object and surface from ``params``); see :meth:`Simulator.run`."""
+    return simulator(params.shape, params.surface, effects, support).run(params, initial_pose, rng)

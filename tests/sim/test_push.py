@@ -1,0 +1,242 @@
+"""Tests for pushjax.sim.push: the MIT protocol, the recorded streams and the physics of each effect."""
+
+import mujoco
+import numpy as np
+import pytest
+
+from pushjax.data.mit_push import PushParams
+from pushjax.geometry import PUSHER_RADIUS, get_object
+from pushjax.sim import push
+from pushjax.sim.effects import Effects
+from pushjax.sim.push import Simulator, simulate_push
+from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION, SURFACES
+
+
+def params(shape="rect1", side=0, point=0.5, angle=0.0, velocity=20.0, acceleration=0.0, surface="abs"):
+    return PushParams(surface=surface, shape=shape, acceleration=acceleration, velocity=velocity, side=side,
+                      point=point, angle=angle)
+
+
+def motion(recording):
+    """Displacement (m, m) and rotation (rad) of the tracked frame over the recording."""
+    pose = recording.true_object_pose
+    return pose[-1, 1:3] - pose[0, 1:3], pose[-1, 3] - pose[0, 3]
+
+
+def tip_in_object_frame(recording):
+    pose, tip = recording.true_object_pose, recording.tip_pose
+    cos, sin = np.cos(pose[:, 3]), np.sin(pose[:, 3])
+    relative = tip[:, 1:3] - pose[:, 1:3]
+    return np.stack([cos * relative[:, 0] + sin * relative[:, 1], -sin * relative[:, 0] + cos * relative[:, 1]], 1)
+
+
+def stop_sample(p):
+    return int(np.ceil(push.push_duration(p) * push.SAMPLE_RATE))
+
+
+def test_sample_push_draws_from_the_mit_grid():
+    rng = np.random.default_rng(0)
+    drawn = [push.sample_push("hex", "pu", rng, velocities=(20.0, 50.0), accelerations=(0.0, 500.0))
+             for _ in range(1000)]
+    assert {p.side for p in drawn} == set(range(6))
+    assert {p.point for p in drawn} == {k / 10 for k in range(11)}
+    assert {p.angle for p in drawn} == {round(a, 3) for a in push.MIT_ANGLES}
+    assert {p.velocity for p in drawn} == {20.0, 50.0} and {p.acceleration for p in drawn} == {0.0, 500.0}
+    assert all(p.surface == "pu" and p.shape == "hex" for p in drawn)
+    again = push.sample_push("hex", "pu", np.random.default_rng(0), velocities=(20.0, 50.0),
+                             accelerations=(0.0, 500.0))
+    assert again == drawn[0]
+    assert set(push.side_points("ellip1")) == {k / 10 for k in range(10)}
+    assert len(push.side_points("tri2")) == 11
+
+
+def test_pusher_line_starts_before_the_contact():
+    obj = get_object("tri2")
+    p = params("tri2", side=1, point=0.3, angle=0.5)
+    start, direction = push.pusher_line(obj, p)
+    point, inward = obj.side_point(1, 0.3)
+    assert np.linalg.norm(direction) == pytest.approx(1.0)
+    assert direction @ inward == pytest.approx(np.cos(0.5))
+    assert inward[0] * direction[1] - inward[1] * direction[0] == pytest.approx(np.sin(0.5))
+    np.testing.assert_allclose(start + push.APPROACH_DISTANCE * direction, point - PUSHER_RADIUS * inward)
+
+
+def test_pusher_motion_constant_and_accelerating():
+    constant = params(velocity=50.0)
+    distance, speed = push.pusher_motion(constant, np.array([0.0, 0.5, 2.0]))
+    np.testing.assert_allclose(distance, [0.0, 0.025, push.APPROACH_DISTANCE + push.PUSH_DISTANCE])
+    np.testing.assert_allclose(speed, [0.05, 0.05, 0.0])
+    accelerating = params(velocity=300.0, acceleration=500.0)
+    distance, speed = push.pusher_motion(accelerating, np.array([0.0, 0.2, 10.0]))
+    np.testing.assert_allclose(distance, [0.0, 0.5 * 0.5 * 0.2 ** 2, 0.053])
+    np.testing.assert_allclose(speed, [0.0, 0.1, 0.0])
+    assert push.push_duration(accelerating) == pytest.approx(np.sqrt(2 * 0.053 / 0.5))
+
+
+def test_recording_layout():
+    p = params(velocity=50.0)
+    recording = simulate_push(p)
+    samples = int(np.ceil((push.push_duration(p) + push.POST_PUSH_DURATION) * 250)) + 1
+    for stream in (recording.tip_pose, recording.object_pose, recording.ft_wrench):
+        assert stream.shape == (samples, 4)
+        np.testing.assert_allclose(stream[:, 0], np.arange(samples) / 250)
+    assert np.all(recording.tip_pose[:, 3] == 0)
+    tip_speed = np.linalg.norm(np.diff(recording.tip_pose[:, 1:3], axis=0), axis=1) * 250
+    assert np.median(tip_speed[:stop_sample(p) - 2]) == pytest.approx(0.05, rel=1e-3)
+    np.testing.assert_allclose(recording.object_pose, recording.true_object_pose)
+
+
+def test_central_push_translates_with_the_pusher():
+    """rect1 pushed through its centre along the normal at 20 mm/s: quasi-static, no rotation."""
+    p = params()
+    recording = simulate_push(p)
+    displacement, rotation = motion(recording)
+    direction = push.pusher_line("rect1", p)[1]
+    assert displacement @ direction == pytest.approx(push.PUSH_DISTANCE, rel=0.05)
+    assert abs(np.degrees(rotation)) < 1.0
+    pushing = recording.ft_wrench[50:stop_sample(p) - 5]
+    weight = get_object("rect1").mass * 9.81
+    force_along = pushing[:, 1:3] @ direction
+    assert np.median(force_along) == pytest.approx(SURFACES["abs"].object_friction * weight, rel=0.1)
+    assert np.abs(pushing[:, 3]).max() < 1e-3
+    # Quasi-static: the plate stops with the pusher.
+    stop = stop_sample(p)
+    assert np.linalg.norm(recording.true_object_pose[-1, 1:3] - recording.true_object_pose[stop, 1:3]) < 5e-4
+
+
+def test_fast_push_slides_on_after_the_pusher_stops():
+    p = params(velocity=300.0)
+    recording = simulate_push(p)
+    stop = stop_sample(p)
+    sliding = recording.true_object_pose[-1, 1:3] - recording.true_object_pose[stop, 1:3]
+    assert np.linalg.norm(sliding) > 0.01
+    assert sliding @ push.pusher_line("rect1", p)[1] > 0
+    assert np.all(recording.ft_wrench[stop + 5:, 1:] == 0)
+
+
+def test_accelerating_push_ramps_up():
+    p = params(velocity=500.0, acceleration=1000.0)
+    recording = simulate_push(p)
+    speed = np.linalg.norm(np.diff(recording.tip_pose[:, 1:3], axis=0), axis=1) * 250
+    stop = stop_sample(p)
+    np.testing.assert_allclose(speed[5:stop - 5], 1.0 * (np.arange(5, stop - 5) + 0.5) / 250, atol=2e-3)
+
+
+def test_initial_pose_moves_the_whole_push():
+    p = params("tri2", side=2, point=0.4, angle=-0.349)
+    at_origin = simulate_push(p)
+    pose = np.array([0.1, -0.05, 2.0])
+    moved = simulate_push(p, initial_pose=pose)
+    cos, sin = np.cos(pose[2]), np.sin(pose[2])
+    rotation = np.array([[cos, -sin], [sin, cos]])
+    np.testing.assert_allclose(moved.true_object_pose[:, 1:3],
+                               pose[:2] + at_origin.true_object_pose[:, 1:3] @ rotation.T, atol=5e-4)
+    np.testing.assert_allclose(np.unwrap(moved.true_object_pose[:, 3]),
+                               np.unwrap(at_origin.true_object_pose[:, 3]) + pose[2], atol=0.01)
+    np.testing.assert_allclose(moved.tip_pose[:, 1:3], pose[:2] + at_origin.tip_pose[:, 1:3] @ rotation.T, atol=5e-4)
+
+
+def test_simulation_is_deterministic():
+    p = params("butter", side=1, point=0.6, angle=0.349)
+    first = simulate_push(p)
+    simulate_push(params("butter", side=3, velocity=300.0))
+    second = simulate_push(p)
+    for name in ("tip_pose", "object_pose", "ft_wrench"):
+        np.testing.assert_array_equal(getattr(first, name), getattr(second, name))
+
+
+def test_bad_push_arguments():
+    simulator = Simulator("rect1", "abs")
+    with pytest.raises(ValueError, match="shape"):
+        simulator.run(params("rect2"))
+    with pytest.raises(ValueError, match="side"):
+        simulator.run(params(side=4))
+    with pytest.raises(ValueError, match="initial_pose"):
+        simulator.run(params(), initial_pose=(0.0, 0.0))
+    with pytest.raises(ValueError, match="rng"):
+        Simulator("rect1", "abs", Effects(tracking_noise=(1e-3, 0.0))).run(params())
+
+
+# Effects: each changes the motion the way physics says.
+
+def test_com_offset_sets_the_rotation_of_a_central_push():
+    # Pushing side 0 (x = +45 mm) towards -x: a centre of mass (and of support pressure) above the push line
+    # turns the plate clockwise, below it counter-clockwise.
+    _, above = motion(simulate_push(params(), Effects(com_offset=(0.0, 0.02))))
+    _, below = motion(simulate_push(params(), Effects(com_offset=(0.0, -0.02))))
+    assert np.degrees(above) < -10 and np.degrees(below) > 10
+
+
+def test_rim_pressure_reduces_rotation():
+    p = params(point=0.8)
+    rotations = [abs(motion(simulate_push(p, Effects(pressure_rim=k)))[1]) for k in (-3.0, 0.0, 3.0)]
+    assert rotations[0] > rotations[1] * 1.1 > rotations[2] * 1.2
+
+
+def test_anisotropic_friction_turns_the_sliding_direction():
+    """A slanted central push: the plate slides preferably along its low-friction axis."""
+    p = params(angle=0.6)
+    early = int(round((push.APPROACH_DISTANCE + 0.01) / 0.02 * 250))
+
+    def sideways(anisotropy):
+        pose = simulate_push(p, Effects(friction_anisotropy=anisotropy)).true_object_pose
+        dx, dy = pose[early, 1:3] - pose[0, 1:3]
+        return abs(dy / dx)
+
+    assert sideways((1.0, 3.0)) < 0.5 * sideways((1.0, 1.0))
+
+
+@pytest.mark.parametrize("anisotropy, steeper", [((1.0, 3.0), False), ((3.0, 1.0), True)])
+def test_anisotropic_friction_bends_free_sliding_towards_the_slippery_axis(anisotropy, steeper):
+    """A plate turned by 30° slides off diagonally in its own frame; friction turns it to the slippery axis."""
+    simulator = Simulator("rect2", "abs", Effects(friction_anisotropy=anisotropy))
+    model, data = simulator.model, simulator.data
+    yaw = np.radians(30)
+    mujoco.mj_resetData(model, data)
+    data.qpos[:7] = [0, 0, simulator._settled_object[2], np.cos(yaw / 2), 0, 0, np.sin(yaw / 2)]
+    data.qpos[7:9] = data.ctrl[:2] = [1.0, 1.0]
+    heading = yaw + np.pi / 4
+    data.qvel[:2] = 0.2 * np.array([np.cos(heading), np.sin(heading)])
+    model.opt.timestep = 0.001
+    mujoco.mj_step(model, data, nstep=300)
+    assert np.linalg.norm(data.qvel[:2]) < 1e-3
+    direction = np.arctan2(data.qpos[1], data.qpos[0]) - yaw  # in the object frame
+    assert (direction > np.pi / 4 + 0.1) if steeper else (direction < np.pi / 4 - 0.1)
+
+
+def test_pusher_friction_makes_the_contact_stick():
+    p = params(angle=0.6)
+    stop = stop_sample(p)
+
+    def slip(mu):
+        local = tip_in_object_frame(simulate_push(p, Effects(pusher_friction=mu)))
+        return abs(local[stop, 1] - local[60, 1])
+
+    slips = [slip(mu) for mu in (0.05, PUSHER_OBJECT_FRICTION, 0.8)]
+    assert slips[0] > 2 * slips[1] and slips[1] > 1.5 * slips[2]
+
+
+def test_tilted_table_pulls_the_pushed_object_downhill():
+    level = motion(simulate_push(params()))[0]
+    tilted = motion(simulate_push(params(), Effects(table_tilt_deg=2.0, table_tilt_azimuth_deg=90.0)))[0]
+    assert tilted[1] - level[1] > 0.005
+
+
+def test_tracking_effects_change_the_recorded_poses_only():
+    p = params("tri1", side=1, point=0.3, angle=0.349)
+    clean = simulate_push(p)
+    bias = (0.002, -0.001, 0.05)
+    biased = simulate_push(p, Effects(tracking_bias=bias))
+    np.testing.assert_array_equal(biased.true_object_pose, clean.true_object_pose)
+    np.testing.assert_array_equal(biased.tip_pose, clean.tip_pose)
+    np.testing.assert_array_equal(biased.ft_wrench, clean.ft_wrench)
+    yaw = clean.true_object_pose[:, 3]
+    offset = np.stack([np.cos(yaw) * bias[0] - np.sin(yaw) * bias[1], np.sin(yaw) * bias[0] + np.cos(yaw) * bias[1]], 1)
+    np.testing.assert_allclose(biased.object_pose[:, 1:3] - clean.true_object_pose[:, 1:3], offset, atol=1e-12)
+    np.testing.assert_allclose(np.angle(np.exp(1j * (biased.object_pose[:, 3] - yaw))), bias[2], atol=1e-12)
+
+    noisy = simulate_push(p, Effects(tracking_noise=(1e-3, 0.01)), rng=np.random.default_rng(3))
+    np.testing.assert_array_equal(noisy.true_object_pose, clean.true_object_pose)
+    error = noisy.object_pose[:, 1:] - clean.true_object_pose[:, 1:]
+    error[:, 2] = np.angle(np.exp(1j * error[:, 2]))
+    np.testing.assert_allclose(error.std(axis=0), [1e-3, 1e-3, 0.01], rtol=0.15)
