@@ -1,0 +1,277 @@
+"""The TFDS builder of the push datasets: array_record files, read back with `tfds.data_source`, no TensorFlow.
+
+One :class:`PushEffects` builder (dataset name ``push_effects``) with a config per experiment and scale, named
+``<experiment>_<scale>`` (see :mod:`pushjax.data.configs`). Building simulates the push sequences the config
+needs (MuJoCo testbed, :mod:`pushjax.sim`) into a raw cache in the MIT layout, cuts them into examples
+(:mod:`pushjax.data.examples`) in worker processes (all cores by default) and writes one array_record file set
+per split::
+
+    builder = PushEffects(config="data_efficiency_smoke", data_dir=DIR)      # seed=3 for another seed
+    builder.download_and_prepare()
+    sources = tfds.data_source("push_effects/data_efficiency_smoke", data_dir=DIR, download=False)
+
+Resuming: a finished dataset is not rebuilt, and the simulated sequences are cached as MIT files under
+``<data_dir>/push_effects_raw/seed<seed>/`` (shared by all experiments and scales of a seed, since the pushes
+drawn for a smaller scale are a prefix of those of a larger one), so an interrupted build only redoes the
+examples of the dataset it was writing. The same config and seed give the same bytes.
+
+The configuration (image size, glimpse size, horizon, ...) is stored in each dataset's metadata
+(``builder.info.metadata["config"]``) and available as ``builder.builder_config.dataset``.
+"""
+
+from __future__ import annotations
+
+import collections
+import concurrent.futures
+import dataclasses
+import multiprocessing
+import os
+import zlib
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import tensorflow_datasets as tfds
+import tqdm
+from array_record.python.array_record_module import ArrayRecordWriter
+from tensorflow_datasets.core import example_serializer
+
+from pushjax.data import configs
+from pushjax.data.examples import ALL_FIELDS
+
+DATASET_NAME = "push_effects"
+RAW_DIR_NAME = "push_effects_raw"
+EXAMPLES_PER_SHARD = 20_000
+
+
+@dataclasses.dataclass(eq=False)
+class PushEffectsConfig(tfds.core.BuilderConfig):
+    """A TFDS builder config carrying the :class:`pushjax.data.configs.DatasetConfig` it builds."""
+
+    dataset: configs.DatasetConfig | None = None
+
+
+def _builder_config(dataset: configs.DatasetConfig) -> PushEffectsConfig:
+    return PushEffectsConfig(
+        name=dataset.name, dataset=dataset,
+        description=f"{dataset.experiment} experiment at {dataset.scale} scale (seed {dataset.seed}); "
+                    "see pushjax.data.configs.")
+
+
+class PushEffects(tfds.core.GeneratorBasedBuilder):
+    """Examples of pushes in the MuJoCo testbed (depth image, pusher, action, object motion, physical state).
+
+    Args:
+      seed: dataset seed; a seed other than 0 builds ``<config>_seed<seed>`` next to the seed-0 datasets.
+      raw_dir: root of the raw (MIT layout) cache of simulated sequences; default
+        ``<data_dir>/push_effects_raw/seed<seed>``. A directory of real MIT files laid out the same way works
+        too, as long as it holds every file the config plans.
+      workers: worker processes for simulation and rendering (default: all cores; 1: this process). Workers are
+        spawned, so a script that builds with several workers must do so under ``if __name__ == "__main__":``.
+      progress: show a progress bar per split.
+      **kwargs: as for ``tfds.core.GeneratorBasedBuilder`` (``config``, ``data_dir``, ...); the file format
+        defaults to ``array_record``.
+    """
+
+    VERSION = tfds.core.Version("1.0.0")
+    RELEASE_NOTES = {"1.0.0": "First release: six experiments at smoke, cpu and paper scale."}
+    BUILDER_CONFIGS = [_builder_config(dataset) for dataset in configs.all_configs()]
+    DEFAULT_CONFIG_NAME = f"data_efficiency_{configs.DEFAULT_SCALE}"
+
+    def __init__(self, *, seed: int = 0, raw_dir: str | os.PathLike | None = None, workers: int | None = None,
+                 progress: bool = True, **kwargs):
+        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+            raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
+        if workers is not None and (not isinstance(workers, int) or workers < 1):
+            raise ValueError(f"workers: expected an integer >= 1, got {workers!r}")
+        config = kwargs.get("config") or self.DEFAULT_CONFIG_NAME
+        if seed:
+            name = config if isinstance(config, str) else config.dataset.name
+            base = {c.name: c for c in self.BUILDER_CONFIGS}.get(name)
+            if base is None:
+                raise ValueError(f"config: expected one of {', '.join(c.name for c in self.BUILDER_CONFIGS)}, "
+                                 f"got {name!r}")
+            kwargs["config"] = _builder_config(dataclasses.replace(base.dataset, seed=seed))
+        kwargs.setdefault("file_format", "array_record")
+        super().__init__(**kwargs)
+        self._raw_dir = Path(raw_dir) if raw_dir is not None else (
+            Path(self.data_dir).parents[2] / RAW_DIR_NAME / f"seed{seed}")
+        self._workers = workers or os.cpu_count() or 1
+        self._progress = progress
+        self._pool = None
+
+    @property
+    def dataset_config(self) -> configs.DatasetConfig:
+        return self.builder_config.dataset
+
+    @property
+    def raw_dir(self) -> Path:
+        return self._raw_dir
+
+    def _info(self) -> tfds.core.DatasetInfo:
+        dataset = self.builder_config.dataset
+        sizes = {"H": dataset.image_size, "W": dataset.image_size}
+        features = tfds.features.FeaturesDict({
+            name: tfds.features.Tensor(
+                shape=tuple(sizes.get(dim, dim) for dim in field.shape), dtype=field.dtype, doc=field.doc,
+                # Images as raw bytes: the default float list serialises element by element (ms per image).
+                encoding=tfds.features.Encoding.BYTES if "H" in field.shape else tfds.features.Encoding.NONE)
+            for name, field in ALL_FIELDS.items()})
+        return tfds.core.DatasetInfo(
+            builder=self,
+            description="Pushes in a MuJoCo stand-in for the MIT Push Dataset: depth image (or point cloud) "
+                        "before the push, pusher position and motion, object motion over the horizon, and the "
+                        "ground-truth physical state (Kloss, Schaal & Bohg).",
+            features=features,
+            metadata=tfds.core.MetadataDict(config=dataclasses.asdict(dataset)),
+        )
+
+    def _generate_splits(self, dl_manager, download_config) -> list[tfds.core.SplitInfo]:
+        # TFDS's own writer buffers a split in memory and spills beyond 1 GB through tf.io.gfile, i.e. needs
+        # TensorFlow; each split is streamed into array_record shards here instead, in generation order.
+        if self._workers == 1:
+            try:
+                return self._write_splits(dl_manager)
+            finally:
+                _close_renderers()
+        # A process pool that fails (BrokenProcessPool) rather than hangs when a worker dies.
+        with concurrent.futures.ProcessPoolExecutor(self._workers, mp_context=multiprocessing.get_context("spawn"),
+                                                    initializer=_init_worker) as pool:
+            self._pool = pool
+            try:
+                return self._write_splits(dl_manager)
+            finally:
+                self._pool = None
+
+    def _write_splits(self, dl_manager) -> list[tfds.core.SplitInfo]:
+        features = self.info.features
+        serializer = example_serializer.ExampleSerializer(features.get_serialized_info())
+        infos = []
+        for split, examples in self._split_generators(dl_manager).items():
+            template = self._get_filename_template(split)
+            shard_lengths, num_bytes, writer = [], 0, None
+            for _, example in examples:
+                if writer is None or shard_lengths[-1] == EXAMPLES_PER_SHARD:
+                    if writer is not None:
+                        writer.close()
+                    shard_lengths.append(0)
+                    writer = ArrayRecordWriter(os.fspath(_partial_shard(template, len(shard_lengths) - 1)),
+                                               "group_size:1")
+                record = serializer.serialize_example(features.encode_example(example))
+                writer.write(record)
+                shard_lengths[-1] += 1
+                num_bytes += len(record)
+            if writer is None:
+                raise ValueError(f"config: split {split!r} of {self.builder_config.name} has no examples")
+            writer.close()
+            for index in range(len(shard_lengths)):
+                os.replace(_partial_shard(template, index),
+                           template.sharded_filepath(shard_index=index, num_shards=len(shard_lengths)))
+            infos.append(tfds.core.SplitInfo(name=split, shard_lengths=shard_lengths, num_bytes=num_bytes,
+                                             filename_template=template))
+        return infos
+
+    def _split_generators(self, dl_manager):
+        plan = configs.plan_splits(self.builder_config.dataset, self._raw_dir)
+        return {name: self._generate_examples(plan, ids, name) for name, ids in plan.splits.items()}
+
+    def _generate_examples(self, plan: configs.SplitPlan, ids: tuple[int, ...], split: str) -> Iterator:
+        """(key, example) of the split's sequences, in sequence order."""
+        dataset = self.builder_config.dataset
+        tasks = [(dataset, plan.jobs[sequence_id], sequence_id) for sequence_id in ids]
+        if self._pool is None:
+            results = map(sequence_task, tasks)
+        else:
+            results = _ordered_map(self._pool, sequence_task, tasks, ahead=4 * self._workers)
+        with tqdm.tqdm(total=len(tasks), disable=not self._progress, unit="seq", desc=f"{dataset.name} {split}") as bar:
+            for sequence_id, examples in zip(ids, results):
+                for k in range(len(examples["sequence_id"])):
+                    yield f"{sequence_id:07d}_{k:04d}", {name: value[k] for name, value in examples.items()}
+                bar.update()
+
+
+def _ordered_map(pool: concurrent.futures.Executor, function, tasks: list, ahead: int) -> Iterator:
+    """``pool.map`` with at most ``ahead`` tasks in flight, so results never pile up in memory."""
+    pending = collections.deque()
+    for task in tasks:
+        pending.append(pool.submit(function, task))
+        if len(pending) >= ahead:
+            yield pending.popleft().result()
+    while pending:
+        yield pending.popleft().result()
+
+
+def _partial_shard(template, index: int) -> Path:
+    """Where shard ``index`` is written before the number of shards is known."""
+    return Path(template.sharded_filepath(shard_index=index, num_shards=1)).with_name(
+        f"{template.dataset_name}-{template.split}.partial-{index:05d}")
+
+
+# Per-process renderers, by (camera, image size, object, surface).
+_RENDERERS: dict = {}
+
+
+def _init_worker() -> None:
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    # Mesa's software rasteriser (llvmpipe) renders in the calling thread: its worker threads cost more than
+    # they save on small images, and the workers already use every core.
+    os.environ.setdefault("LP_NUM_THREADS", "0")
+    # One XLA thread per worker: the workers already use every core.
+    os.environ["XLA_FLAGS"] = (os.environ.get("XLA_FLAGS", "") + " --xla_cpu_multi_thread_eigen=false "
+                               "intra_op_parallelism_threads=1").strip()
+
+
+def _close_renderers() -> None:
+    while _RENDERERS:
+        _RENDERERS.popitem()[1].close()
+
+
+def sequence_rng(dataset: configs.DatasetConfig, job) -> np.random.Generator:
+    """The generator of a sequence's windows, transforms and pusher moves (independent of split and worker)."""
+    return np.random.default_rng([dataset.seed, zlib.crc32(job.path.name.encode("utf-8"))])
+
+
+def sequence_task(task) -> dict[str, np.ndarray]:
+    """Worker: records the sequence if it is not cached yet, then returns its stacked examples.
+
+    Args:
+      task: (DatasetConfig, ``pushjax.sim.dataset.PushJob``, sequence id).
+    """
+    from pushjax.data.examples import make_renderer, sequence_examples
+    from pushjax.data.mit_push import load_push
+    from pushjax.sim.dataset import record_push
+
+    dataset, job, sequence_id = task
+    if not job.path.exists():
+        record_push(job)
+    push = load_push(job.path)
+    key = (dataset.camera, dataset.image_size, job.params.shape, job.params.surface)
+    if key not in _RENDERERS:
+        _RENDERERS[key] = make_renderer(dataset, job.params.shape, job.params.surface)
+    return sequence_examples(push, dataset, _RENDERERS[key], sequence_id, sequence_rng(dataset, job))
+
+
+def build(experiment: str, scale: str = configs.DEFAULT_SCALE, data_dir: str | os.PathLike | None = None,
+          seed: int = 0, workers: int | None = None, progress: bool = True,
+          raw_dir: str | os.PathLike | None = None) -> PushEffects:
+    """Builds (or finds) one dataset and returns its builder; see :class:`PushEffects` for the arguments."""
+    builder = PushEffects(config=f"{experiment}_{scale}", data_dir=data_dir, seed=seed, workers=workers,
+                          progress=progress, raw_dir=raw_dir)
+    builder.download_and_prepare()
+    return builder
+
+
+def dataset_name(experiment: str, scale: str = configs.DEFAULT_SCALE, seed: int = 0) -> str:
+    """The ``tfds.data_source`` name of a dataset, e.g. ``push_effects/data_efficiency_cpu``."""
+    configs.get_config(experiment, scale, seed)  # validates the names
+    return f"{DATASET_NAME}/{experiment}_{scale}" + (f"/seed={seed}" if seed else "")
+
+
+def load(experiment: str, scale: str = configs.DEFAULT_SCALE, data_dir: str | os.PathLike | None = None,
+         seed: int = 0, split: str | None = None):
+    """The built dataset's ``tfds.data_source``: split name -> random-access source (or one source for ``split``).
+
+    Each element is a dict of NumPy arrays with the fields of ``pushjax.data.schema.FIELDS`` plus
+    ``pushjax.data.examples.EXTRA_FIELDS``. Nothing is built: a missing dataset raises.
+    """
+    return tfds.data_source(dataset_name(experiment, scale, seed), data_dir=data_dir, split=split, download=False)

@@ -1,0 +1,353 @@
+"""Dataset configurations: one per experiment of the paper and per scale, and their split plans.
+
+An experiment (Kloss, Schaal & Bohg, Secs. IV-C to IV-F and V) fixes which simulated push sequences are
+recorded and how they are assigned to splits; a scale fixes how many, how many examples each sequence gives and
+the image resolution. Splits are made per push sequence: a sequence's examples all land in the same split, and
+no training split shares a sequence with a validation or test split. The ``velocities`` and ``objects``
+experiments offer several alternative training splits (``train_*``), which share sequences with each other by
+design (each is a different training set for the same test splits); those alternatives all have the same number
+of sequences and take an equal share from each of their velocities or objects.
+
+Experiments (split names in brackets):
+
+``data_efficiency`` [train, test]
+    All 11 objects at 20 mm/s on abs, a random 5/6 : 1/6 split of each object's sequences.
+``new_pushes`` [train, validation, test]
+    The same sequences; test holds every push at the angles 0° and ±20° and every push at a held-out tenth of
+    each object's contact points (side, point); the rest is split 5/6 : 1/6 into train and validation.
+``velocities`` [train_20, train_10_20, train_20_50, test_10, test_20, ..., test_300]
+    All objects; test sets per velocity from 10 to 300 mm/s, training sets at 20, at 10 + 20 and at
+    20 + 50 mm/s.
+``objects`` [train_butter, train_butter_hex, train_butter_hex_ellip1, train_butter_hex_tri1, test_ellipses,
+test_triangles]
+    Training on butter, butter + hex, and butter + hex + ellip1 or tri1; tests on all ellipses and on all
+    triangles (for ellip1 and tri1 on sequences kept out of training).
+``viewpoint`` [train, test]
+    As ``data_efficiency``, seen by the free (oblique) camera; examples carry the organised point cloud.
+``repeated`` [test]
+    One push configuration (``REPEATED_PUSH``) seen under many scene transforms, for the visual figures.
+
+Scales:
+
+``smoke``
+    At most 2 k examples per dataset, built in seconds; used by the tests.
+``cpu`` (default)
+    Sized so that the full ``data_efficiency`` experiment (issue 6) trains on a 2-core machine within a few
+    hours: 64 x 64 depth images, 20 x 20 px glimpses and about 20 k training examples (11 objects x 25 training
+    sequences x 72 examples; 72 examples per sequence as at ``paper`` scale, which also keeps the simulation's
+    share of the build time at about a third). The top-down camera sees a 0.331 m square of the table, so a pixel covers
+    5.2 mm (``paper``: 2.6 mm). Locating a point by whole pixels then costs 5.2 / sqrt(12) = 1.5 mm RMS per
+    axis (``paper``: 0.75 mm); a learned localiser interpolates below a pixel, but expect its position error
+    to be about a millimetre larger than at ``paper`` resolution, with the object's motion over 0.5 s at
+    20 mm/s being about 10 mm.
+``paper``
+    The paper's sizes: ``data_efficiency`` 191 k / 38 k, ``new_pushes`` about 114 k / 23 k / 91 k,
+    ``objects`` 35 k per training set, ``viewpoint`` 191 k / 38 k, ``repeated`` 200; 128 x 128 images and
+    80 x 80 px glimpses (the paper's glimpse size, which sets the 1.8 M / 2.7 M parameter counts).
+
+All numbers that define a dataset live in :class:`DatasetConfig`; ``get_config(experiment, scale, seed)``
+returns the one used by the builders.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import zlib
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from pushjax.data.mit_push import PushParams
+from pushjax.geometry.objects import OBJECT_NAMES
+
+EXPERIMENTS = ("data_efficiency", "new_pushes", "velocities", "objects", "viewpoint", "repeated")
+SCALES = ("smoke", "cpu", "paper")
+DEFAULT_SCALE = "cpu"
+
+TRAIN_VELOCITY = 20.0
+"""mm/s, the velocity of every experiment but ``velocities``."""
+TEST_VELOCITIES = (10.0, 20.0, 50.0, 75.0, 100.0, 150.0, 200.0, 300.0)
+"""mm/s, the test velocities of the ``velocities`` experiment."""
+VELOCITY_TRAIN_SETS = {"train_20": (20.0,), "train_10_20": (10.0, 20.0), "train_20_50": (20.0, 50.0)}
+OBJECT_TRAIN_SETS = {
+    "train_butter": ("butter",),
+    "train_butter_hex": ("butter", "hex"),
+    "train_butter_hex_ellip1": ("butter", "hex", "ellip1"),
+    "train_butter_hex_tri1": ("butter", "hex", "tri1"),
+}
+OBJECT_TEST_SETS = {"test_ellipses": ("ellip1", "ellip2", "ellip3"), "test_triangles": ("tri1", "tri2", "tri3")}
+NEW_PUSH_TEST_ANGLES_DEG = (-20.0, 0.0, 20.0)
+REPEATED_PUSH = PushParams(surface="abs", shape="rect1", acceleration=0.0, velocity=20.0, side=0, point=0.3,
+                           angle=0.349)
+"""The push of the ``repeated`` experiment: rect1, 30 % along side 0, 20° to the normal, 20 mm/s."""
+
+
+@dataclasses.dataclass(frozen=True)
+class DatasetConfig:
+    """Everything that defines one dataset.
+
+    Attributes:
+      experiment: one of :data:`EXPERIMENTS`.
+      scale: one of :data:`SCALES`.
+      seed: seed of the push draws, splits, windows, scene transforms and pusher displacements.
+      image_size: height = width of the depth image, pixels.
+      glimpse_size: side of the square glimpse a model cuts around the pusher, pixels (not used to build the
+        data; stored so that models read it from the dataset config).
+      horizon: prediction horizon, s.
+      camera: ``"top_down"`` or ``"free"`` (see :mod:`pushjax.render.camera`).
+      surfaces: surfaces of the recorded pushes.
+      pushes_per_object: sequences per object and velocity in pools that feed training splits.
+      test_pushes_per_object: sequences per object and velocity in pools that only feed test splits.
+      windows_per_sequence: random window start times drawn per sequence.
+      transforms_per_window: random scene transforms per window.
+      no_contact_fraction: share of examples whose pusher is moved so that it does not touch the object.
+      test_fraction: share of a shared pool's sequences that go to the test split.
+      validation_fraction: share of the remaining sequences that go to the validation split (``new_pushes``).
+      held_out_point_fraction: share of each object's contact points held out for the ``new_pushes`` test.
+      max_translation: the object's centre of mass lands uniformly in a square of this half width about the
+        camera's table point, m.
+      max_rotation: scene rotations are uniform in [-max_rotation, max_rotation], rad.
+      repeated_start_time: window start of the ``repeated`` examples, s.
+    """
+
+    experiment: str
+    scale: str
+    seed: int = 0
+    image_size: int = 64
+    glimpse_size: int = 20
+    horizon: float = 0.5
+    camera: str = "top_down"
+    surfaces: tuple[str, ...] = ("abs",)
+    pushes_per_object: int = 30
+    test_pushes_per_object: int = 5
+    windows_per_sequence: int = 24
+    transforms_per_window: int = 3
+    no_contact_fraction: float = 1.0 / 3.0
+    test_fraction: float = 1.0 / 6.0
+    validation_fraction: float = 1.0 / 6.0
+    held_out_point_fraction: float = 0.1
+    max_translation: float = 0.04
+    max_rotation: float = math.pi
+    repeated_start_time: float = 0.5
+
+    def __post_init__(self):
+        if self.experiment not in EXPERIMENTS:
+            raise ValueError(f"experiment: expected one of {', '.join(EXPERIMENTS)}, got {self.experiment!r}")
+        if self.scale not in SCALES:
+            raise ValueError(f"scale: expected one of {', '.join(SCALES)}, got {self.scale!r}")
+        if self.camera not in ("top_down", "free"):
+            raise ValueError(f"camera: expected 'top_down' or 'free', got {self.camera!r}")
+        if not isinstance(self.seed, int) or self.seed < 0:
+            raise ValueError(f"seed: expected an integer >= 0, got {self.seed!r}")
+        for name in ("image_size", "glimpse_size", "pushes_per_object", "test_pushes_per_object",
+                     "windows_per_sequence", "transforms_per_window"):
+            if not isinstance(getattr(self, name), int) or getattr(self, name) < 1:
+                raise ValueError(f"{name}: expected an integer >= 1, got {getattr(self, name)!r}")
+        for name in ("no_contact_fraction", "test_fraction", "validation_fraction", "held_out_point_fraction"):
+            if not 0.0 <= getattr(self, name) < 1.0:
+                raise ValueError(f"{name}: expected a fraction in [0, 1), got {getattr(self, name)!r}")
+        if not self.horizon > 0:
+            raise ValueError(f"horizon: expected > 0 s, got {self.horizon!r}")
+
+    @property
+    def name(self) -> str:
+        """The TFDS config name: ``<experiment>_<scale>``, with ``_seed<seed>`` for seeds other than 0."""
+        return f"{self.experiment}_{self.scale}" + (f"_seed{self.seed}" if self.seed else "")
+
+    @property
+    def examples_per_sequence(self) -> int:
+        return self.windows_per_sequence * self.transforms_per_window
+
+    @property
+    def has_point_cloud(self) -> bool:
+        return self.camera == "free"
+
+
+# (pushes_per_object, test_pushes_per_object, windows_per_sequence, transforms_per_window) per scale; images.
+_SIZES = {
+    "smoke": dict(pushes_per_object=6, test_pushes_per_object=1, windows_per_sequence=4, transforms_per_window=3,
+                  image_size=64, glimpse_size=20),
+    "cpu": dict(pushes_per_object=30, test_pushes_per_object=5, windows_per_sequence=24, transforms_per_window=3,
+                image_size=64, glimpse_size=20),
+    "paper": dict(pushes_per_object=290, test_pushes_per_object=48, windows_per_sequence=24,
+                  transforms_per_window=3, image_size=128, glimpse_size=80),
+}
+_EXPERIMENT_SIZES = {
+    ("velocities", "smoke"): dict(pushes_per_object=3, windows_per_sequence=3),
+    ("objects", "smoke"): dict(test_pushes_per_object=2, windows_per_sequence=3),
+    ("objects", "cpu"): dict(pushes_per_object=50, test_pushes_per_object=10),
+    ("objects", "paper"): dict(pushes_per_object=240, transforms_per_window=6),
+    ("repeated", "smoke"): dict(transforms_per_window=24),
+    ("repeated", "cpu"): dict(transforms_per_window=200),
+    ("repeated", "paper"): dict(transforms_per_window=200),
+}
+
+
+def get_config(experiment: str, scale: str = DEFAULT_SCALE, seed: int = 0) -> DatasetConfig:
+    """The configuration of ``experiment`` at ``scale`` (see the module docstring) with ``seed``."""
+    if scale not in _SIZES:
+        raise ValueError(f"scale: expected one of {', '.join(SCALES)}, got {scale!r}")
+    sizes = dict(_SIZES[scale], **_EXPERIMENT_SIZES.get((experiment, scale), {}))
+    if experiment == "viewpoint":
+        sizes["camera"] = "free"
+    if experiment == "repeated":
+        sizes["windows_per_sequence"] = 1
+        sizes["no_contact_fraction"] = 0.0
+    return DatasetConfig(experiment=experiment, scale=scale, seed=seed, **sizes)
+
+
+def all_configs(seed: int = 0) -> list[DatasetConfig]:
+    return [get_config(experiment, scale, seed) for experiment in EXPERIMENTS for scale in SCALES]
+
+
+@dataclasses.dataclass(frozen=True)
+class SplitPlan:
+    """The sequences of a dataset and the sequence ids of each split.
+
+    Attributes:
+      jobs: the push sequences, indexed by sequence id, as ``pushjax.sim.dataset.PushJob`` values: where the raw
+        file is cached and how to record it when it is missing.
+      splits: split name -> sorted sequence ids.
+    """
+
+    jobs: tuple
+    splits: dict[str, tuple[int, ...]]
+
+
+def _key(*parts) -> list[int]:
+    return [zlib.crc32(str(part).encode("utf-8")) for part in parts]
+
+
+def _pool(obj: str, velocity: float, pushes: int, config: DatasetConfig, raw_dir: Path) -> list:
+    """The recording jobs of ``pushes`` draws of ``obj`` at ``velocity`` on every configured surface."""
+    from pushjax.sim.dataset import plan_pushes  # MuJoCo: only needed when planning.
+
+    return plan_pushes(raw_dir, [obj], list(config.surfaces), pushes, seed=config.seed, velocities=(velocity,))
+
+
+def _split_off(items: list, fraction: float, rng: np.random.Generator) -> tuple[list, list]:
+    """(rest, held) with ``round(len * fraction)`` items (at least 1 when ``fraction`` > 0) held, at random."""
+    count = min(len(items) - 1, max(1 if fraction > 0 else 0, round(len(items) * fraction)))
+    order = rng.permutation(len(items))
+    held = sorted(order[:count])
+    rest = sorted(order[count:])
+    return [items[i] for i in rest], [items[i] for i in held]
+
+
+def held_out_contact_points(obj: str, config: DatasetConfig) -> frozenset[int]:
+    """Contact point ids (see :func:`contact_point_id`) of ``obj`` held out for the ``new_pushes`` test."""
+    from pushjax.sim.push import side_points
+    from pushjax.geometry.objects import get_object
+
+    count = len(get_object(obj).sides) * len(side_points(obj))
+    rng = np.random.default_rng(_key(config.seed, obj, "held-out points"))
+    return frozenset(int(i) for i in rng.permutation(count)[:max(1, round(count * config.held_out_point_fraction))])
+
+
+def contact_point_id(params: PushParams) -> int:
+    """``side * points_per_side + index of the point`` on the MIT grid of ``params.shape``."""
+    from pushjax.sim.push import side_points
+
+    points = side_points(params.shape)
+    return params.side * len(points) + int(np.argmin(np.abs(points - params.point)))
+
+
+def plan_splits(config: DatasetConfig, raw_dir: str | Path) -> SplitPlan:
+    """The sequences of ``config``'s dataset and their assignment to splits; deterministic for the config.
+
+    Args:
+      config: the dataset.
+      raw_dir: root of the raw (MIT layout) cache of the simulated sequences.
+    """
+    raw_dir = Path(raw_dir)
+    per_split: dict[str, list] = {}  # split name -> recording jobs
+    experiment = config.experiment
+    if experiment in ("data_efficiency", "viewpoint", "new_pushes"):
+        per_split = {"train": [], "test": []} if experiment != "new_pushes" else {
+            "train": [], "validation": [], "test": []}
+        for obj in OBJECT_NAMES:
+            pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object, config, raw_dir)
+            rng = np.random.default_rng(_key(config.seed, obj, experiment, "split"))
+            if experiment == "new_pushes":
+                held_points = held_out_contact_points(obj, config)
+                held_angles = np.radians(NEW_PUSH_TEST_ANGLES_DEG)
+                is_test = [bool(np.any(np.abs(held_angles - job.params.angle) < 1e-3))
+                           or contact_point_id(job.params) in held_points for job in pool]
+                per_split["test"] += [job for job, test in zip(pool, is_test) if test]
+                rest = [job for job, test in zip(pool, is_test) if not test]
+                train, validation = _split_off(rest, config.validation_fraction, rng)
+                per_split["train"] += train
+                per_split["validation"] += validation
+            else:
+                train, test = _split_off(pool, config.test_fraction, rng)
+                per_split["train"] += train
+                per_split["test"] += test
+    elif experiment == "velocities":
+        train_pools: dict[float, dict[str, list]] = {}
+        for velocity in TEST_VELOCITIES:
+            trained = any(velocity in velocities for velocities in VELOCITY_TRAIN_SETS.values())
+            per_split[f"test_{velocity:g}"] = []
+            for obj in OBJECT_NAMES:
+                if trained:
+                    pool = _pool(obj, velocity, config.pushes_per_object, config, raw_dir)
+                    rng = np.random.default_rng(_key(config.seed, obj, velocity, "split"))
+                    train, test = _split_off(pool, config.test_fraction, rng)
+                    train_pools.setdefault(velocity, {})[obj] = train
+                else:
+                    test = _pool(obj, velocity, config.test_pushes_per_object, config, raw_dir)
+                per_split[f"test_{velocity:g}"] += test
+        for name, velocities in VELOCITY_TRAIN_SETS.items():
+            per_split[name] = [job for obj in OBJECT_NAMES for job in _equal_shares(
+                [train_pools[v][obj] for v in velocities], len(train_pools[TRAIN_VELOCITY][obj]))]
+    elif experiment == "objects":
+        trained = sorted({obj for objects in OBJECT_TRAIN_SETS.values() for obj in objects})
+        train_pools = {}
+        for name, objects in OBJECT_TEST_SETS.items():
+            per_split[name] = []
+            for obj in objects:
+                if obj in trained:
+                    pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object + config.test_pushes_per_object,
+                                 config, raw_dir)
+                    rng = np.random.default_rng(_key(config.seed, obj, experiment, "split"))
+                    train_pools[obj], test = _split_off(pool, config.test_pushes_per_object / len(pool), rng)
+                else:
+                    test = _pool(obj, TRAIN_VELOCITY, config.test_pushes_per_object, config, raw_dir)
+                per_split[name] += test
+        for obj in trained:
+            if obj not in train_pools:
+                train_pools[obj] = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object, config, raw_dir)
+        size = len(train_pools["butter"])
+        for name, objects in OBJECT_TRAIN_SETS.items():
+            per_split[name] = _equal_shares([train_pools[obj] for obj in objects], size)
+        per_split = {name: per_split[name] for name in (*OBJECT_TRAIN_SETS, *OBJECT_TEST_SETS)}
+    elif experiment == "repeated":
+        from pushjax.sim.dataset import PushJob
+        from pushjax.sim.effects import Effects
+
+        per_split = {"test": [PushJob(path=raw_path(raw_dir, REPEATED_PUSH), params=REPEATED_PUSH,
+                                      effects=Effects(), support="grid", noise_seed=(config.seed,),
+                                      attributes=None)]}
+
+    by_path = {job.path: job for jobs in per_split.values() for job in jobs}
+    paths = sorted(by_path)
+    ids = {path: index for index, path in enumerate(paths)}
+    splits = {name: tuple(sorted({ids[job.path] for job in jobs})) for name, jobs in per_split.items()}
+    return SplitPlan(jobs=tuple(by_path[path] for path in paths), splits=splits)
+
+
+def _equal_shares(pools: Sequence[list], size: int) -> list:
+    """``size`` items taking an equal share (the first ones) from each pool; earlier pools get the remainder."""
+    shares = [size // len(pools) + (k < size % len(pools)) for k in range(len(pools))]
+    for pool, share in zip(pools, shares):
+        if share > len(pool):
+            raise ValueError(f"pools: a pool of {len(pool)} sequences cannot give {share}")
+    return [item for pool, share in zip(pools, shares) for item in pool[:share]]
+
+
+def raw_path(raw_dir: str | Path, params: PushParams) -> Path:
+    """Where the raw (MIT layout) file of a sequence is cached."""
+    from pushjax.data.mit_push import push_file_path
+
+    return push_file_path(raw_dir, params)

@@ -1,0 +1,180 @@
+"""Perception shared by all model variants (Kloss et al., Sec. III-C, Fig. 3).
+
+* Glimpse: a square patch cut around the pusher tip, whose pixel position is known, encoded by three
+  conv layers (ReLU, max-pooling, batch norm) into a flat vector.
+* Object position: the full image through four conv and three deconv layers to a one-channel map at
+  input resolution whose spatial softmax gives the object's pixel position; that pixel is mapped to the
+  world by the image scale at the table (top-down camera) or by a bilinear depth lookup and
+  unprojection (free viewpoint).
+
+Images are [B, H, W, C] (C = 1 for depth, 3 for point clouds); pixel coordinates (u right, v down,
+pixel centres at +0.5) and cameras follow `pushjax.render.camera`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import flax.linen as nn
+import jax
+import jax.numpy as jnp
+
+from pushjax.render import camera as camera_lib
+
+
+def standardise_images(images: jax.Array) -> jax.Array:
+    """Per-image, per-channel zero mean and unit variance.
+
+    Makes the networks invariant to the camera height and the table's position in the point cloud.
+
+    Args:
+      images: [B, H, W, C] depth [m] or point cloud [m].
+
+    Returns:
+      [B, H, W, C] dimensionless.
+    """
+    mean = images.mean(axis=(1, 2), keepdims=True)
+    std = images.std(axis=(1, 2), keepdims=True)
+    return (images - mean) / (std + 1e-6)
+
+
+def extract_glimpses(images: jax.Array, centre_pixels: jax.Array, size: int) -> jax.Array:
+    """Square patches of `size` x `size` pixels centred on `centre_pixels`, edge-padded at the border.
+
+    Args:
+      images: [B, H, W, C].
+      centre_pixels: [B, 2] (u, v) [pixels]; rounded to the nearest pixel corner grid, so not
+        differentiable with respect to the position.
+      size: side length [pixels].
+
+    Returns:
+      [B, size, size, C].
+    """
+    if size <= 0:
+        raise ValueError(f"size: expected a positive glimpse size in pixels, got {size}")
+    padded = jnp.pad(images, ((0, 0), (size, size), (size, size), (0, 0)), mode="edge")
+    # The patch spans [centre - size/2, centre + size/2) in pixel-corner coordinates.
+    top_left = jnp.round(centre_pixels - size / 2).astype(jnp.int32) + size
+    top_left = jnp.clip(top_left, 0, jnp.array([padded.shape[2] - size, padded.shape[1] - size]))
+
+    def cut(image, corner):
+        return jax.lax.dynamic_slice(image, (corner[1], corner[0], 0), (size, size, image.shape[-1]))
+
+    return jax.vmap(cut)(padded, top_left)
+
+
+class GlimpseEncoder(nn.Module):
+    """Three conv layers with ReLU, each followed by 2x2 max-pooling and batch norm, then flattened.
+
+    Attributes:
+      features: channels of the three conv layers.
+      kernel_size: side of the square conv kernels [pixels].
+      batch_norm_momentum: decay of the running batch statistics.
+    """
+
+    features: Sequence[int]
+    kernel_size: int
+    batch_norm_momentum: float = 0.9
+
+    @nn.compact
+    def __call__(self, glimpses: jax.Array, train: bool) -> jax.Array:
+        """[B, g, g, C] standardised glimpses -> [B, D] encoding."""
+        x = glimpses
+        for channels in self.features:
+            x = nn.Conv(channels, (self.kernel_size, self.kernel_size))(x)
+            x = nn.relu(x)
+            x = nn.max_pool(x, (2, 2), strides=(2, 2), padding="SAME")
+            x = nn.BatchNorm(use_running_average=not train, momentum=self.batch_norm_momentum)(x)
+        return x.reshape(x.shape[0], -1)
+
+
+def spatial_softmax(logits: jax.Array) -> jax.Array:
+    """Expected pixel position under the softmax of a one-channel map.
+
+    Args:
+      logits: [B, H, W].
+
+    Returns:
+      [B, 2] (u, v) [pixels], pixel centres at +0.5.
+    """
+    batch, height, width = logits.shape
+    probabilities = jax.nn.softmax(logits.reshape(batch, -1), axis=-1)
+    centres = camera_lib.pixel_centres(width, height).reshape(-1, 2)
+    return probabilities @ centres
+
+
+class ObjectLocator(nn.Module):
+    """Four conv and three deconv layers to a one-channel map at input resolution; its spatial softmax.
+
+    The first conv keeps the resolution and the other three halve it; the three stride-2 deconvs
+    restore it, so H and W must be multiples of 8.
+
+    Attributes:
+      conv_features: channels of the four conv layers.
+      deconv_features: channels of the first two deconv layers (the last has one).
+      kernel_size: side of the square kernels [pixels].
+    """
+
+    conv_features: Sequence[int]
+    deconv_features: Sequence[int]
+    kernel_size: int = 3
+
+    @nn.compact
+    def __call__(self, images: jax.Array) -> jax.Array:
+        """[B, H, W, C] standardised images -> [B, 2] object pixel (u, v)."""
+        height, width = images.shape[1:3]
+        if height % 8 or width % 8:
+            raise ValueError(f"images: expected height and width divisible by 8, got {height}x{width}")
+        kernel = (self.kernel_size, self.kernel_size)
+        x = images
+        for index, channels in enumerate(self.conv_features):
+            stride = 1 if index == 0 else 2
+            x = nn.relu(nn.Conv(channels, kernel, strides=(stride, stride))(x))
+        for channels in self.deconv_features:
+            x = nn.relu(nn.ConvTranspose(channels, kernel, strides=(2, 2))(x))
+        # No bias: the spatial softmax ignores a constant offset, so it would get no gradient.
+        logits = nn.ConvTranspose(1, kernel, strides=(2, 2), use_bias=False)(x)[..., 0]
+        return spatial_softmax(logits)
+
+
+def cameras_from_batch(intrinsics: jax.Array, extrinsics: jax.Array, width: int, height: int):
+    """A batch of cameras (array fields with a leading batch axis) from the dataset fields.
+
+    Args:
+      intrinsics: [B, 4] fx, fy, cx, cy [pixels] (`camera_intrinsics`).
+      extrinsics: [B, 4, 4] world_from_camera (`camera_extrinsics`) [m].
+      width, height: image size [pixels].
+    """
+    return camera_lib.Camera(
+        fx=intrinsics[:, 0], fy=intrinsics[:, 1], cx=intrinsics[:, 2], cy=intrinsics[:, 3],
+        world_from_camera=extrinsics, width=width, height=height,
+    )
+
+
+def table_points_top_down(pixels: jax.Array, cameras: camera_lib.Camera) -> jax.Array:
+    """World xy [B, 2] [m] of pixels [B, 2] by the image scale at the table (downward cameras).
+
+    Exact on the table plane for a camera looking straight down (`top_down_camera`).
+    """
+
+    def one(pixel, camera):
+        axis_distance = camera.position[2] / camera.rotation[2, 2]
+        return camera_lib.unproject(pixel, axis_distance, camera)[:2]
+
+    return jax.vmap(one)(pixels, cameras)
+
+
+def depth_from_point_cloud(point_clouds: jax.Array, cameras: camera_lib.Camera) -> jax.Array:
+    """Depth images [B, H, W] [m] of organised world-frame point clouds [B, H, W, 3] [m]."""
+    return jax.vmap(lambda cloud, camera: -camera_lib.world_to_camera(cloud, camera)[..., 2])(
+        point_clouds, cameras
+    )
+
+
+def unproject_with_depth(pixels: jax.Array, depth: jax.Array, cameras: camera_lib.Camera) -> jax.Array:
+    """World points [B, N, 3] [m] seen at pixels [B, N, 2], depth bilinearly looked up in [B, H, W] [m]."""
+
+    def one(pixel, image, camera):
+        return camera_lib.unproject(pixel, camera_lib.bilinear_lookup(image, pixel), camera)
+
+    return jax.vmap(one)(pixels, depth, cameras)

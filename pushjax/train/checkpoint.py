@@ -1,0 +1,77 @@
+"""Orbax checkpoints of a (stacked) train state plus JSON metadata.
+
+Orbax writes each step into a temporary folder that it renames when complete, so a run killed while
+saving leaves the previous checkpoint intact; :meth:`Checkpointer.restore_latest` returns the newest
+complete one.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any
+
+import jax
+import orbax.checkpoint as ocp
+
+
+class Checkpointer:
+    """Saves and restores ``(state, metadata)`` pairs under ``directory/<step>``.
+
+    Args:
+      directory: the checkpoint folder (created when missing).
+      max_to_keep: newest checkpoints kept on disk.
+    """
+
+    def __init__(self, directory: str | os.PathLike, max_to_keep: int = 2):
+        self._manager = ocp.CheckpointManager(
+            os.path.abspath(directory),
+            options=ocp.CheckpointManagerOptions(
+                max_to_keep=max_to_keep, enable_async_checkpointing=False, create=True
+            ),
+            item_names=("state", "metadata"),
+        )
+
+    def latest_step(self) -> int | None:
+        """Step of the newest complete checkpoint, or None."""
+        return self._manager.latest_step()
+
+    def save(self, step: int, state: Any, metadata: dict) -> None:
+        """Writes `state` (a pytree of arrays) and JSON-serialisable `metadata` at `step`."""
+        self._manager.save(
+            step,
+            args=ocp.args.Composite(
+                state=ocp.args.StandardSave(state), metadata=ocp.args.JsonSave(metadata)
+            ),
+            force=True,
+        )
+        self._manager.wait_until_finished()
+
+    def latest_metadata(self) -> dict | None:
+        """The metadata of the newest checkpoint (without reading its state), or None."""
+        step = self.latest_step()
+        if step is None:
+            return None
+        restored = self._manager.restore(step, args=ocp.args.Composite(metadata=ocp.args.JsonRestore()))
+        return restored.metadata
+
+    def restore_latest(self, abstract_state: Any) -> tuple[int, Any, dict] | None:
+        """(step, state, metadata) of the newest checkpoint, or None when there is none.
+
+        Args:
+          abstract_state: a pytree with the state's structure, shapes and dtypes (e.g. the freshly
+            initialised state, or `jax.eval_shape` of its constructor).
+        """
+        step = self.latest_step()
+        if step is None:
+            return None
+        abstract = jax.tree.map(ocp.utils.to_shape_dtype_struct, abstract_state)
+        restored = self._manager.restore(
+            step,
+            args=ocp.args.Composite(
+                state=ocp.args.StandardRestore(abstract), metadata=ocp.args.JsonRestore()
+            ),
+        )
+        return step, restored.state, restored.metadata
+
+    def close(self) -> None:
+        self._manager.close()

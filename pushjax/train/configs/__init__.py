@@ -1,0 +1,54 @@
+"""Training configurations per scale: `smoke` (tests, seconds), `cpu` (a laptop, minutes), `paper`."""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+
+from pushjax.models.networks import ModelConfig
+
+SCALES = ("smoke", "cpu", "paper")
+
+
+@dataclasses.dataclass(frozen=True)
+class TrainConfig:
+    """Everything a training run needs besides the data.
+
+    Attributes:
+      model: the architecture (its `variant` is usually overridden per run).
+      learning_rate: Adam step size.
+      batch_size: examples per step and model.
+      num_steps: optimisation steps per model.
+      weight_decay: lambda of the 0.5 * |w|^2 kernel penalty.
+      log_every: steps between metric rows in the log (and progress-bar updates).
+      checkpoint_every: steps between checkpoints (the last step is always saved).
+      eval_batch_size: examples per evaluation batch.
+    """
+
+    model: ModelConfig
+    learning_rate: float = 1e-4
+    batch_size: int = 32
+    num_steps: int = 75_000
+    weight_decay: float = 1e-3
+    log_every: int = 100
+    checkpoint_every: int = 5_000
+    eval_batch_size: int = 256
+
+    def __post_init__(self):
+        for name in ("batch_size", "num_steps", "log_every", "checkpoint_every", "eval_batch_size"):
+            if getattr(self, name) <= 0:
+                raise ValueError(f"{name}: expected a positive integer, got {getattr(self, name)}")
+        if self.learning_rate <= 0:
+            raise ValueError(f"learning_rate: expected > 0, got {self.learning_rate}")
+
+    def with_variant(self, variant: str, view: str | None = None) -> "TrainConfig":
+        """This config with the model's variant (and optionally view) replaced."""
+        model = dataclasses.replace(self.model, variant=variant, view=view or self.model.view)
+        return dataclasses.replace(self, model=model)
+
+
+def get_config(scale: str) -> TrainConfig:
+    """The `TrainConfig` of `scale` (one of `SCALES`)."""
+    if scale not in SCALES:
+        raise ValueError(f"scale: expected one of {SCALES}, got {scale!r}")
+    return importlib.import_module(f"pushjax.train.configs.{scale}").get_config()

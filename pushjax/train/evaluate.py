@@ -1,0 +1,133 @@
+"""Evaluation in the paper's units (Kloss et al., Tables 1-2).
+
+* ``trans_percent`` / ``rot_percent``: mean translation [mm] / rotation [deg] error as a percentage of
+  the ``zero`` baseline's (predicting no motion) on the same examples, with standard errors
+  (``*_se``: the error's standard error of the mean relative to the baseline's mean).
+* ``pos_mm``: object-position error [mm].
+* Physical state errors of the hybrid, simple and error variants on examples with contact:
+  ``contact_mm`` (contact point), ``normal_deg`` (surface normal), ``s`` (|s - contact flag|, all
+  examples) and ``push_velocity_deg`` (effective push velocity v_p; from the predicted contact and
+  normal through Lynch's stage 1 for hybrid / error, predicted directly by simple).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import jax
+import numpy as np
+
+from pushjax.models.networks import ERROR_OPTIONS, PushModel
+from pushjax.physics import lynch
+from pushjax.train.train import Examples, SweepResult, TrainState, model_fields
+
+M_TO_MM = 1000.0
+
+
+def predict(
+    model: PushModel, state: TrainState, examples: Examples, batch_size: int,
+    error_options: np.ndarray | None = None,
+) -> dict[str, np.ndarray]:
+    """Model outputs (eval mode: running batch statistics) for every example, as NumPy arrays.
+
+    Args:
+      model: the model.
+      state: one model's `TrainState` (no model axis).
+      examples: the split (schema fields).
+      batch_size: examples per jitted call; the last batch is padded by repetition.
+      error_options: the error-term flags of `PushModel.__call__`, or None for the variant's.
+    """
+    fields = model_fields(model.config)
+    count = len(examples[fields[0]])
+    variables = {"params": state.params, "batch_stats": state.batch_stats}
+    apply = jax.jit(
+        lambda variables, batch: model.apply(variables, batch, train=False, error_options=error_options)
+    )
+    chunks = []
+    for start in range(0, count, batch_size):
+        indices = np.minimum(np.arange(start, start + batch_size), count - 1)
+        outputs = apply(variables, {name: examples[name][indices] for name in fields})
+        chunks.append(jax.tree.map(lambda x, n=min(batch_size, count - start): np.asarray(x)[:n], outputs))
+    return {name: np.concatenate([chunk[name] for chunk in chunks]) for name in chunks[0]}
+
+
+def _angle_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    cosine = np.sum(a * b, -1) / (np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1))
+    return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+
+
+def _mean_and_se(values: np.ndarray) -> tuple[float, float]:
+    if values.size == 0:
+        return float("nan"), float("nan")
+    se = values.std(ddof=1) / np.sqrt(values.size) if values.size > 1 else float("nan")
+    return float(values.mean()), float(se)
+
+
+def error_metrics(predictions: Mapping[str, np.ndarray], examples: Examples) -> dict[str, float]:
+    """Errors of `predictions` (outputs of `predict`) against the ground truth in `examples`."""
+    true_motion = np.asarray(examples["motion"], np.float64)
+    motion = np.asarray(predictions["motion"], np.float64)
+    translation_error = np.linalg.norm(motion[:, :2] - true_motion[:, :2], axis=-1) * M_TO_MM
+    rotation_error = np.degrees(np.abs(motion[:, 2] - true_motion[:, 2]))
+    zero_translation = np.linalg.norm(true_motion[:, :2], axis=-1).mean() * M_TO_MM
+    zero_rotation = np.degrees(np.abs(true_motion[:, 2])).mean()
+    metrics = {"count": float(len(motion))}
+    for name, error, baseline in (
+        ("trans", translation_error, zero_translation), ("rot", rotation_error, zero_rotation)
+    ):
+        mean, se = _mean_and_se(error)
+        metrics[f"{name}_{'mm' if name == 'trans' else 'deg'}"] = mean
+        metrics[f"{name}_zero_{'mm' if name == 'trans' else 'deg'}"] = float(baseline)
+        metrics[f"{name}_percent"] = 100 * mean / baseline
+        metrics[f"{name}_percent_se"] = 100 * se / baseline
+    if "object_pos" in predictions:
+        metrics["pos_mm"], metrics["pos_mm_se"] = _mean_and_se(
+            np.linalg.norm(predictions["object_pos"] - examples["object_pos"], axis=-1) * M_TO_MM
+        )
+    touching = np.asarray(examples["contact_flag"]) > 0.5
+    if "contact" in predictions:
+        metrics["contact_mm"], _ = _mean_and_se(
+            np.linalg.norm(predictions["contact"] - examples["contact"], axis=-1)[touching] * M_TO_MM
+        )
+    if "normal" in predictions:
+        valid = touching & (np.linalg.norm(predictions["normal"], axis=-1) > 0)
+        metrics["normal_deg"], _ = _mean_and_se(
+            _angle_deg(predictions["normal"][valid], examples["normal"][valid])
+        )
+    if "s" in predictions:
+        metrics["s"], _ = _mean_and_se(np.abs(predictions["s"] - examples["contact_flag"]))
+    push_velocity = predictions.get("push_velocity")
+    if push_velocity is None and "normal" in predictions:
+        push_velocity = np.asarray(lynch.effective_push_velocity(
+            predictions["contact"], predictions["normal"], examples["action"], examples["l"], examples["mu"]
+        )[0])
+    if push_velocity is not None:
+        true_push_velocity = examples["push_velocity"]
+        valid = (
+            touching
+            & (np.linalg.norm(push_velocity, axis=-1) > 0)
+            & (np.linalg.norm(true_push_velocity, axis=-1) > 0)
+        )
+        metrics["push_velocity_deg"], _ = _mean_and_se(
+            _angle_deg(push_velocity[valid], true_push_velocity[valid])
+        )
+    return metrics
+
+
+def evaluate(
+    model: PushModel, state: TrainState, examples: Examples, batch_size: int = 256,
+    error_options: np.ndarray | None = None,
+) -> dict[str, float]:
+    """`error_metrics` of one model's predictions on `examples` (arguments as in `predict`)."""
+    return error_metrics(predict(model, state, examples, batch_size, error_options), examples)
+
+
+def evaluate_sweep(result: SweepResult, examples: Examples, batch_size: int = 256) -> list[dict[str, float]]:
+    """`evaluate` for every model of a sweep, in the order of `result.specs`."""
+    return [
+        evaluate(
+            result.model, result.model_state(k), examples, batch_size,
+            None if spec.variant is None else np.asarray(ERROR_OPTIONS[spec.variant], np.float32),
+        )
+        for k, spec in enumerate(result.specs)
+    ]

@@ -1,0 +1,274 @@
+"""The TFDS push datasets at smoke scale: fields, composition, splits, determinism and physical consistency."""
+
+import filecmp
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+import tensorflow_datasets as tfds
+
+from pushjax.data import batches, configs
+from pushjax.data.builder import build, load
+from pushjax.data.examples import ALL_FIELDS
+from pushjax.data.schema import FIELDS
+from pushjax.geometry import OBJECT_NAMES, THICKNESS
+from pushjax.physics import lynch
+from pushjax.render import free_camera, project, top_down_camera
+
+QUASI_STATIC_BOUND = 0.25
+"""Median |predicted - simulated| / median |simulated| of the testbed's quasi-static agreement (tests/sim)."""
+
+
+@pytest.fixture(scope="session")
+def data_dir(tmp_path_factory):
+    tfds.disable_progress_bar()
+    return tmp_path_factory.mktemp("push_datasets")
+
+
+@pytest.fixture(scope="session")
+def smoke(data_dir):
+    """experiment -> split -> data source, built on first request."""
+    built = {}
+
+    def get(experiment):
+        if experiment not in built:
+            build(experiment, "smoke", data_dir=data_dir, workers=1, progress=False)
+            built[experiment] = load(experiment, "smoke", data_dir=data_dir)
+        return built[experiment]
+
+    return get
+
+
+def _column(source, name):
+    return np.array([source[i][name] for i in range(len(source))])
+
+
+def _all(source):
+    return next(batches(source, len(source), seed=0, shuffle=False, drop_remainder=False))
+
+
+def test_fields_shapes_and_dtypes(smoke):
+    sources = smoke("data_efficiency")
+    assert set(sources) == {"train", "test"}
+    size = configs.get_config("data_efficiency", "smoke").image_size
+    for source in sources.values():
+        example = source[0]
+        assert set(example) == set(ALL_FIELDS) and set(FIELDS) <= set(example)
+        batch = next(batches(source, 8, seed=0))
+        for name, field in ALL_FIELDS.items():
+            shape = tuple(size if dim in ("H", "W") else dim for dim in field.shape)
+            assert batch[name].shape == (8, *shape), name
+            assert batch[name].dtype == field.dtype, name
+            assert np.all(np.isfinite(batch[name])), name
+
+
+def test_no_contact_share_is_a_third(smoke):
+    flags = np.concatenate([_column(source, "contact_flag") for source in smoke("data_efficiency").values()])
+    assert abs(np.mean(flags == 0) - 1 / 3) <= 0.05
+
+
+def test_no_contact_examples_are_consistent(smoke):
+    data = _all(smoke("data_efficiency")["train"])
+    moved = data["pusher_moved"] == 1
+    assert np.any(moved)
+    assert np.all(data["contact_flag"][moved] == 0)
+    np.testing.assert_array_equal(data["motion"][moved], 0.0)
+    none = data["contact_flag"] == 0
+    for name in ("contact", "normal", "action_from_contact", "push_velocity"):
+        np.testing.assert_array_equal(data[name][none], 0.0)
+    np.testing.assert_allclose(np.linalg.norm(data["normal"][~none], axis=1), 1.0, atol=1e-5)
+    # Several start times per sequence, some windows hold shorter pushes than the full horizon.
+    full = 0.5 * 20e-3
+    assert np.any(np.linalg.norm(data["action"], axis=1) < 0.9 * full)
+    assert len(np.unique(data["start_time"])) > len(np.unique(data["sequence_id"]))
+
+
+@pytest.mark.parametrize("experiment", ["data_efficiency", "new_pushes", "velocities", "objects", "viewpoint"])
+def test_splits_are_disjoint_by_sequence(smoke, experiment):
+    sources = smoke(experiment)
+    plan = configs.plan_splits(configs.get_config(experiment, "smoke"), "/unused")
+    sequences = {name: set(_column(source, "sequence_id").tolist()) for name, source in sources.items()}
+    assert sequences == {name: set(ids) for name, ids in plan.splits.items()}
+    training = [name for name in sequences if name.startswith("train")]
+    held_out = [name for name in sequences if not name.startswith("train")]
+    for first in held_out:
+        for second in training + [name for name in held_out if name != first]:
+            assert not sequences[first] & sequences[second], (first, second)
+    if experiment in ("data_efficiency", "new_pushes", "viewpoint"):
+        assert not sequences["train"] & set().union(*(sequences[name] for name in held_out))
+
+
+def test_new_pushes_test_holds_only_held_out_angles_and_points(smoke):
+    sources = smoke("new_pushes")
+    config = configs.get_config("new_pushes", "smoke")
+    test_angles = np.radians(configs.NEW_PUSH_TEST_ANGLES_DEG)
+
+    def held_out(data):
+        angle = np.any(np.abs(data["push_angle"][:, None] - test_angles) < 1e-3, axis=1)
+        point = np.array([point_id in configs.held_out_contact_points(OBJECT_NAMES[obj], config)
+                          for obj, point_id in zip(data["object_id"], data["contact_point_id"])])
+        return angle | point
+
+    assert np.all(held_out(_all(sources["test"])))
+    for name in ("train", "validation"):
+        assert not np.any(held_out(_all(sources[name])))
+
+
+def test_velocity_and_object_compositions(smoke):
+    sources = smoke("velocities")
+    for velocity in configs.TEST_VELOCITIES:
+        assert set(_column(sources[f"test_{velocity:g}"], "velocity")) == {velocity}
+    counts = {name: len(sources[name]) for name in configs.VELOCITY_TRAIN_SETS}
+    assert len(set(counts.values())) == 1
+    for name, velocities in configs.VELOCITY_TRAIN_SETS.items():
+        assert set(_column(sources[name], "velocity")) == set(velocities)
+
+    sources = smoke("objects")
+    assert len({len(sources[name]) for name in configs.OBJECT_TRAIN_SETS}) == 1
+    for name, objects in {**configs.OBJECT_TRAIN_SETS, **configs.OBJECT_TEST_SETS}.items():
+        assert {OBJECT_NAMES[i] for i in _column(sources[name], "object_id")} == set(objects), name
+
+
+def test_same_seed_gives_same_bytes(smoke, data_dir, tmp_path):
+    smoke("data_efficiency")
+    build("data_efficiency", "smoke", data_dir=tmp_path, workers=2, progress=False,
+          raw_dir=data_dir / "push_effects_raw" / "seed0")
+    first = data_dir / "push_effects" / "data_efficiency_smoke" / "1.0.0"
+    second = tmp_path / "push_effects" / "data_efficiency_smoke" / "1.0.0"
+    files = sorted(path.name for path in first.glob("*.array_record-*"))
+    assert files and files == sorted(path.name for path in second.glob("*.array_record-*"))
+    match, mismatch, errors = filecmp.cmpfiles(first, second, files, shallow=False)
+    assert match == files, (mismatch, errors)
+
+
+def test_ground_truth_state_reproduces_motion(smoke):
+    data = _all(smoke("data_efficiency")["train"])
+    touching = data["contact_flag"] == 1
+    predicted = np.asarray(lynch.predict(data["contact"], data["normal"], data["action_from_contact"], data["l"],
+                                         data["mu"], data["contact_flag"]))[touching, :2]
+    simulated = data["motion"][touching, :2]
+    error = np.median(np.linalg.norm(predicted - simulated, axis=1))
+    assert error / np.median(np.linalg.norm(simulated, axis=1)) <= QUASI_STATIC_BOUND
+    stage1, _ = lynch.effective_push_velocity(data["contact"], data["normal"], data["action_from_contact"],
+                                              data["l"], data["mu"])
+    np.testing.assert_allclose(data["push_velocity"], stage1, atol=1e-7)
+
+
+def test_pixels_and_depth_agree_with_the_camera(smoke):
+    data = _all(smoke("data_efficiency")["test"])
+    camera = top_down_camera(64, 64)
+    lift = np.full((len(data["object_pos"]), 1), THICKNESS)
+    pixels = np.asarray(project(np.concatenate([data["object_pos"], lift], 1), camera)[0])
+    np.testing.assert_allclose(data["object_pixel"], pixels, atol=1e-3)
+    np.testing.assert_allclose(data["camera_extrinsics"][0], camera.world_from_camera, atol=1e-6)
+    np.testing.assert_allclose(data["camera_intrinsics"][0], [camera.fx, camera.fy, camera.cx, camera.cy])
+    # The depth image sees the object's top face at its centre of mass (pusher never covers it).
+    rows, columns = np.floor(data["object_pixel"][:, ::-1]).astype(int).T
+    seen = data["depth"][np.arange(len(rows)), rows, columns, 0]
+    assert np.mean(np.abs(seen - (0.4 - THICKNESS)) < 1e-3) > 0.9
+    # Scene transforms move the recorded scene: the object lands in the configured square, the pusher in view.
+    assert np.all(np.abs(data["object_pos"]) <= configs.get_config("data_efficiency", "smoke").max_translation)
+    for pusher in (data["pusher_pos"], data["pusher_pos"] + data["action"]):
+        pixels = np.asarray(project(np.concatenate([pusher, lift], 1), camera)[0])
+        assert np.all((pixels > 0) & (pixels < 64))
+
+
+def test_viewpoint_point_clouds(smoke):
+    data = _all(smoke("viewpoint")["test"])
+    camera = free_camera(64, 64)
+    np.testing.assert_allclose(data["camera_extrinsics"][0], camera.world_from_camera, atol=1e-6)
+    cloud = data["point_cloud"]
+    on_table = np.abs(cloud[..., 2]) < 1e-3
+    assert on_table.mean() > 0.5
+    assert np.any(np.abs(cloud[..., 2] - THICKNESS) < 1e-3)  # object top faces
+    np.testing.assert_allclose(data["object_pixel"], np.asarray(project(np.concatenate(
+        [data["object_pos"], np.full((len(cloud), 1), THICKNESS)], 1), camera)[0]), atol=1e-2)
+
+
+def test_repeated_push_under_scene_transforms(smoke):
+    data = _all(smoke("repeated")["test"])
+    assert len(data["depth"]) == configs.get_config("repeated", "smoke").examples_per_sequence
+    assert len(np.unique(data["sequence_id"])) == 1 and np.all(data["contact_flag"] == 1)
+    assert len(np.unique(data["scene_transform"][:, 0, 2])) == len(data["depth"])
+    # Undoing each scene rotation gives the same recorded motion.
+    angle = np.arctan2(data["scene_transform"][:, 1, 0], data["scene_transform"][:, 0, 0])
+    cos, sin = np.cos(-angle), np.sin(-angle)
+    motion = data["motion"]
+    recorded = np.stack([cos * motion[:, 0] - sin * motion[:, 1], sin * motion[:, 0] + cos * motion[:, 1]], 1)
+    np.testing.assert_allclose(recorded, np.broadcast_to(recorded[0], recorded.shape), atol=1e-6)
+    assert np.linalg.norm(recorded[0]) > 1e-3
+
+
+def test_batches_indices_epochs_and_determinism(smoke):
+    source = smoke("data_efficiency")["test"]
+    subset = np.arange(0, len(source), 3)
+    first = list(batches(source, 4, seed=1, indices=subset, num_epochs=2))
+    second = list(batches(source, 4, seed=1, indices=subset, num_epochs=2))
+    assert len(first) == 2 * (len(subset) // 4)
+    for a, b in zip(first, second):
+        np.testing.assert_array_equal(a["depth"], b["depth"])
+    seen = np.concatenate([batch["sequence_id"] for batch in first[:len(subset) // 4]])
+    allowed = set(_column(source, "sequence_id")[subset].tolist())
+    assert set(seen.tolist()) <= allowed
+    with pytest.raises(ValueError, match="indices"):
+        next(batches(source, 4, seed=0, indices=[len(source)]))
+    with pytest.raises(ValueError, match="batch_size"):
+        next(batches(source, 0, seed=0))
+
+
+def test_loading_never_imports_tensorflow(smoke, data_dir):
+    smoke("data_efficiency")
+    script = textwrap.dedent(f"""
+        import sys
+        import pushjax.data as data
+        sources = data.load("data_efficiency", "smoke", data_dir={str(data_dir)!r})
+        batch = next(data.batches(sources["train"], 16, seed=0))
+        assert batch["depth"].shape == (16, 64, 64, 1)
+        import tensorflow_datasets as tfds
+        source = tfds.data_source("push_effects/data_efficiency_smoke", data_dir={str(data_dir)!r},
+                                  split="test", download=False)
+        assert len(source) > 0 and source[0]["depth"].shape == (64, 64, 1)
+        assert "tensorflow" not in sys.modules, "tensorflow was imported"
+        print("ok")
+    """)
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                            env={**os.environ, "MUJOCO_GL": "egl"})
+    assert result.returncode == 0 and result.stdout.strip().endswith("ok"), result.stderr[-3000:]
+
+
+def test_cli_builds_a_dataset(tmp_path):
+    result = subprocess.run(
+        [sys.executable, "-m", "experiments.build_dataset", "--experiment=repeated", "--scale=smoke",
+         f"--data_dir={tmp_path}", "--workers=1"],
+        capture_output=True, text=True, cwd=Path(__file__).resolve().parents[2])
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert "repeated_smoke: test 24 examples" in result.stdout
+    assert len(load("repeated", "smoke", data_dir=tmp_path, split="test")) == 24
+
+
+def test_seeded_configs_and_bad_names():
+    assert configs.get_config("objects", "paper", seed=3).name == "objects_paper_seed3"
+    with pytest.raises(ValueError, match="experiment"):
+        configs.get_config("nope", "smoke")
+    with pytest.raises(ValueError, match="scale"):
+        configs.get_config("data_efficiency", "huge")
+
+
+def test_paper_scale_sizes():
+    def sizes(experiment):
+        config = configs.get_config(experiment, "paper")
+        plan = configs.plan_splits(config, "/unused")
+        return {name: len(ids) * config.examples_per_sequence for name, ids in plan.splits.items()}
+
+    assert sizes("data_efficiency") == pytest.approx({"train": 190e3, "test": 38e3}, rel=0.03)
+    assert sizes("new_pushes") == pytest.approx({"train": 114e3, "validation": 23e3, "test": 91e3}, rel=0.03)
+    assert all(size == pytest.approx(35e3, rel=0.03)
+               for name, size in sizes("objects").items() if name.startswith("train"))
+    assert sizes("repeated") == {"test": 200}
+    cpu = configs.get_config("data_efficiency", "cpu")
+    plan = configs.plan_splits(cpu, "/unused")
+    assert len(plan.splits["train"]) * cpu.examples_per_sequence == pytest.approx(20e3, rel=0.05)
