@@ -1,0 +1,58 @@
+"""Wall time of the whole loop (``pushjax.loop.close_loop``) on 500 simulated pushes.
+
+Records the pushes once (testbed, no declared effects; not timed) — by default 5 objects x 2 surfaces x 50
+pushes at velocities from 10 to 200 mm/s, so that the fast ones slide on after the pusher stops, with a
+centre-of-mass offset — then times the loop end to end in this process: reading the files, windows and
+contact annotation, diagnosis, fitting every effect and the forward selection (including JAX
+compilation), the fallback if needed, figures and report. The acceptance bound is 3 minutes on 2 cores.
+
+    python benchmarks/close_loop.py [--data_dir DIR] [--workdir OUT] [--pushes_per_pair 50] [--workers 2]
+
+With ``--data_dir`` the pushes are recorded there (or reused when present).
+"""
+
+import argparse
+import json
+import tempfile
+import time
+from pathlib import Path
+
+from pushjax.loop import close_loop
+from pushjax.sim.dataset import record_pushes
+from pushjax.sim.effects import Effects
+
+OBJECTS = ["rect1", "tri1", "ellip2", "hex", "butter"]
+SURFACES = ["abs", "plywood"]
+VELOCITIES = [10.0, 20.0, 50.0, 100.0, 200.0]
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--data_dir", type=Path, default=None, help="where to record (or reuse) the pushes")
+    parser.add_argument("--workdir", type=Path, default=None, help="report directory (default: temporary)")
+    parser.add_argument("--pushes_per_pair", type=int, default=50, help="pushes per object and surface")
+    parser.add_argument("--effects", default="com_offset=0.01,-0.005", help="testbed effects (record_pushes syntax)")
+    parser.add_argument("--workers", type=int, default=2, help="recording processes")
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args()
+
+    with tempfile.TemporaryDirectory() as scratch:
+        data_dir = args.data_dir or Path(scratch) / "pushes"
+        workdir = args.workdir or Path(scratch) / "loop"
+        start = time.perf_counter()
+        recorded = record_pushes(data_dir, OBJECTS, SURFACES, args.pushes_per_pair, seed=args.seed,
+                                 velocities=VELOCITIES, effects=Effects.parse(args.effects), declare_effects=False,
+                                 workers=args.workers, progress=True)
+        print(f"recorded {len(recorded.written)} pushes ({len(recorded.skipped)} reused) in "
+              f"{time.perf_counter() - start:.1f} s")
+        start = time.perf_counter()
+        report = close_loop(data_dir, workdir, seed=args.seed)
+        elapsed = time.perf_counter() - start
+    pushes = report["n_pushes"]["fit"] + report["n_pushes"]["heldout"]
+    print(json.dumps({key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "explained")},
+                     indent=1))
+    print(f"close_loop on {pushes} pushes: {elapsed:.1f} s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,55 @@
+r"""Close the loop on measured pushes: residual → the missing effect → refit → held-out error before and after.
+
+  python -m experiments.close_loop --data_dir=DIR --workdir=OUT [--horizon=0.5] [--seed=0] \
+      [--heldout_fraction=0.3] [--min_gain=0.1] [--min_strength=0.1] [--steps=300]
+
+DIR holds pushes in the raw MIT layout (``<surface>/<object>/motion_surface=...h5``: real MIT files or the
+testbed's, ``python -m experiments.record_pushes``); only the streams and the file-name fields are used.
+Writes ``OUT/report.json``, ``OUT/details.json``, ``OUT/report.md`` and ``OUT/figures/*.png``; see
+:mod:`pushjax.loop`.
+"""
+
+import dataclasses
+import json
+
+from absl import app, flags
+
+from pushjax.loop import LoopSettings, close_loop
+from pushjax.loop.fit import FitSettings
+
+_DATA_DIR = flags.DEFINE_string("data_dir", None, "Root of the pushes (raw MIT layout).", required=True)
+_WORKDIR = flags.DEFINE_string("workdir", None, "Output directory.", required=True)
+_HORIZON = flags.DEFINE_float("horizon", 0.5, "Prediction window in s.", lower_bound=0.0)
+_SEED = flags.DEFINE_integer("seed", 0, "Seed of the split, bootstraps and error term.", lower_bound=0)
+_HELDOUT = flags.DEFINE_float("heldout_fraction", 0.3, "Share of push sequences held out.")
+_MIN_GAIN = flags.DEFINE_float("min_gain", LoopSettings.min_gain,
+                               "Relative held-out error cut an effect must reach at its lower bound.")
+_MIN_STRENGTH = flags.DEFINE_float("min_strength", LoopSettings.min_strength,
+                                   "Share of the error a variable's correction must remove to count as structure.")
+_STEPS = flags.DEFINE_integer("steps", FitSettings.steps, "Adam steps per effect fit.", lower_bound=1)
+
+
+def main(argv):
+    if len(argv) > 1:
+        raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
+    if _HORIZON.value <= 0:
+        raise app.UsageError(f"--horizon: expected a positive duration in s, got {_HORIZON.value}")
+    if not 0 < _HELDOUT.value < 1:
+        raise app.UsageError(f"--heldout_fraction: expected a fraction in (0, 1), got {_HELDOUT.value}")
+    settings = LoopSettings(horizon=_HORIZON.value, heldout_fraction=_HELDOUT.value, min_gain=_MIN_GAIN.value,
+                            min_strength=_MIN_STRENGTH.value,
+                            fit=dataclasses.replace(FitSettings(), steps=_STEPS.value))
+    try:
+        report = close_loop(_DATA_DIR.value, _WORKDIR.value, settings, seed=_SEED.value)
+    except ValueError as error:
+        message = str(error)
+        if message.startswith("data_dir"):
+            message = "--" + message
+        raise app.UsageError(message) from None
+    summary = {key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "explained", "fallback")}
+    print(json.dumps(summary, indent=2))
+    print(f"report: {_WORKDIR.value}/report.md")
+
+
+if __name__ == "__main__":
+    app.run(main)

@@ -1,0 +1,297 @@
+"""Fitting effect parameters by gradient descent through the differentiable model, many models at once.
+
+Every candidate model is the full effect library (:func:`pushjax.physics.effects.compose` of all
+effects) with a 0/1 mask per effect: masked effects keep their "no effect" parameters (zeros). So
+candidates with different effect sets share one compiled program; their losses are summed, which
+leaves each candidate's gradient its own, and Adam (elementwise) then optimises them independently.
+Parameters are optimised in units of each parameter's typical magnitude.
+
+The loss of a window is its translation error over the mean translation of the fit windows plus its
+rotation error over their mean rotation (the paper's translation + rotation error, as fractions of the
+``zero`` baseline), each smoothed near zero (``sqrt(e^2 + floor^2)``).
+
+Parameter uncertainty: the cluster-robust sandwich covariance ``H^-1 (sum_j g_j g_j^T) H^-1`` of the
+optimum, with ``H`` the Gauss-Newton loss Hessian and ``g_j`` the loss gradient summed over push sequence ``j``
+(windows of one push are not independent), propagated to the reported values by their Jacobian.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from collections.abc import Sequence
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
+from jax.flatten_util import ravel_pytree
+
+from pushjax.loop.examples import Examples
+from pushjax.physics import effects as effects_lib
+from pushjax.physics.effects import EFFECT_NAMES, EFFECTS, PushInputs
+
+PAD_MULTIPLE = 1024
+"""Example counts are padded (with zero weight) to a multiple of this, so programs compile once per size."""
+
+
+@dataclasses.dataclass(frozen=True)
+class FitSettings:
+    """Optimiser settings.
+
+    Attributes:
+      steps: Adam steps (full batch).
+      learning_rate: initial step size in units of each parameter's typical magnitude (cosine decay).
+      translation_floor_mm: smoothing of the translation error near 0, mm.
+      rotation_floor_deg: smoothing of the rotation error near 0, deg.
+    """
+
+    steps: int = 300
+    learning_rate: float = 0.05
+    translation_floor_mm: float = 0.1
+    rotation_floor_deg: float = 0.1
+
+
+@dataclasses.dataclass(frozen=True)
+class FitResult:
+    """One fitted candidate model.
+
+    Attributes:
+      effects: the effect names, in library order.
+      params: {effect: {parameter: NumPy array}} in SI units (see :mod:`pushjax.physics.effects`).
+      physical: {effect: {value name: {"value": float, "std": float or None}}}, the reported values with
+        their standard errors (None where the value is not differentiable at the optimum).
+      loss: final fit loss.
+    """
+
+    effects: tuple[str, ...]
+    params: dict[str, dict[str, np.ndarray]]
+    physical: dict[str, dict[str, dict[str, float]]]
+    loss: float
+
+
+@dataclasses.dataclass(frozen=True)
+class Batch:
+    """Examples as padded device arrays: inputs [P, ...], target [P, 3], weight [P] (0 for padding)."""
+
+    inputs: PushInputs
+    target: jax.Array
+    weight: jax.Array
+    count: int
+
+
+def to_batch(examples: Examples) -> Batch:
+    """Pads ``examples`` to a multiple of :data:`PAD_MULTIPLE` by repeating the first window."""
+    count = len(examples)
+    size = max(PAD_MULTIPLE, math.ceil(count / PAD_MULTIPLE) * PAD_MULTIPLE)
+    index = np.concatenate([np.arange(count), np.zeros(size - count, int)])
+
+    def pad(values):
+        return jnp.asarray(np.asarray(values)[index], jnp.float32)
+
+    inputs = PushInputs(**{field.name: pad(getattr(examples.inputs, field.name))
+                           for field in dataclasses.fields(PushInputs)})
+    weight = np.zeros(size, np.float32)
+    weight[:count] = 1.0
+    return Batch(inputs=inputs, target=pad(examples.target), weight=jnp.asarray(weight), count=count)
+
+
+def zero_scales(examples: Examples) -> tuple[float, float]:
+    """(mean translation m, mean |rotation| rad) of the windows: the zero baseline's mean errors."""
+    target = np.asarray(examples.target)
+    return (max(float(np.mean(np.linalg.norm(target[:, :2], axis=1))), 1e-6),
+            max(float(np.mean(np.abs(target[:, 2]))), 1e-6))
+
+
+_FULL_MODEL = effects_lib.compose(EFFECT_NAMES)
+_TYPICAL = {name: {key: float(value) for key, value in EFFECTS[name].typical.items()} for name in EFFECT_NAMES}
+
+
+def _params_from_scaled(scaled, mask):
+    """SI parameters of one candidate from its scaled variables and [E] effect mask."""
+    return {name: {key: mask[i] * value * _TYPICAL[name][key] for key, value in scaled[name].items()}
+            for i, name in enumerate(EFFECT_NAMES)}
+
+
+def _scaled_from_params(params):
+    return {name: {key: value / _TYPICAL[name][key] for key, value in params[name].items()} for name in EFFECT_NAMES}
+
+
+def _window_loss(params, inputs, target, scales, floors):
+    prediction = _FULL_MODEL(params, inputs)
+    translation = jnp.sum((prediction[:, :2] - target[:, :2]) ** 2, axis=-1) / scales[0] ** 2
+    rotation = (prediction[:, 2] - target[:, 2]) ** 2 / scales[1] ** 2
+    return jnp.sqrt(translation + floors[0] ** 2) + jnp.sqrt(rotation + floors[1] ** 2)
+
+
+def _candidate_loss(scaled, mask, batch_inputs, target, weight, scales, floors):
+    losses = _window_loss(_params_from_scaled(scaled, mask), batch_inputs, target, scales, floors)
+    return jnp.sum(weight * losses) / jnp.sum(weight)
+
+
+@functools.partial(jax.jit, static_argnames=("steps", "learning_rate"))
+def _optimise(scaled, masks, inputs, target, weight, scales, floors, steps, learning_rate):
+    optimiser = optax.adam(optax.cosine_decay_schedule(learning_rate, steps))
+
+    def total(scaled):
+        losses = jax.vmap(_candidate_loss, in_axes=(0, 0, None, None, None, None, None))(
+            scaled, masks, inputs, target, weight, scales, floors)
+        return jnp.sum(losses), losses
+
+    def project(scaled):
+        params = jax.vmap(_params_from_scaled)(scaled, masks)
+        return _scaled_from_params(effects_lib.project_params(params))
+
+    def step(carry, _):
+        scaled, state = carry
+        (_, losses), gradient = jax.value_and_grad(total, has_aux=True)(scaled)
+        updates, state = optimiser.update(gradient, state, scaled)
+        return (project(optax.apply_updates(scaled, updates)), state), losses
+
+    scaled = project(scaled)
+    (scaled, _), _ = jax.lax.scan(step, (scaled, optimiser.init(scaled)), None, length=steps)
+    return scaled, total(scaled)[1]
+
+
+@jax.jit
+def _residual_jacobian(scaled, mask, inputs, target, scales):
+    """Scaled residuals [N, 3] of one candidate and their Jacobian [N, 3, P] by the flat variables."""
+    flat, unravel = ravel_pytree(scaled)
+
+    def residuals(flat):
+        prediction = _FULL_MODEL(_params_from_scaled(unravel(flat), mask), inputs)
+        return (prediction - target) / jnp.stack([scales[0], scales[0], scales[1]])
+
+    return residuals(flat), jax.jacfwd(residuals)(flat)
+
+
+@jax.jit
+def _physical_jacobian(scaled, mask):
+    flat, unravel = ravel_pytree(scaled)
+
+    def values(flat):
+        params = _params_from_scaled(unravel(flat), mask)
+        return ravel_pytree(effects_lib.physical_params(params))[0]
+
+    return values(flat), jax.jacfwd(values)(flat)
+
+
+def _masks(candidates: Sequence[Sequence[str]]) -> np.ndarray:
+    return np.array([[name in candidate for name in EFFECT_NAMES] for candidate in candidates], np.float32)
+
+
+def _stack(trees):
+    return jax.tree.map(lambda *leaves: jnp.stack(leaves), *trees)
+
+
+def fit_effects(
+    candidates: Sequence[Sequence[str]],
+    examples: Examples,
+    settings: FitSettings = FitSettings(),
+    initial: Sequence[dict | None] | None = None,
+) -> list[FitResult]:
+    """Fits every candidate effect set on ``examples`` at once.
+
+    Args:
+      candidates: effect-name sets, e.g. ``[("cof_offset",), ("cof_offset", "table_tilt")]``.
+      examples: the fit windows.
+      settings: optimiser settings.
+      initial: per candidate, None or SI parameters {effect: {parameter: value}} to start from
+        (effects not given start at "no effect").
+
+    Returns:
+      One :class:`FitResult` per candidate, in order.
+    """
+    candidates = [tuple(effects_lib.init_params(candidate)) for candidate in candidates]  # checked, in library order
+    if not candidates:
+        return []
+    batch = to_batch(examples)
+    scales = jnp.asarray(zero_scales(examples), jnp.float32)
+    floors = jnp.asarray([1e-3 * settings.translation_floor_mm / scales[0],
+                          math.radians(settings.rotation_floor_deg) / scales[1]], jnp.float32)
+    # Pad the candidate axis to the library size: one compiled program for every round of selection.
+    slots = max(len(EFFECT_NAMES), len(candidates))
+    masks = _masks(list(candidates) + [()] * (slots - len(candidates)))
+    initial = list(initial or []) + [None] * (slots - len(initial or []))
+    starts = []
+    for start in initial:
+        params = effects_lib.init_params()
+        for name, values in (start or {}).items():
+            params[name] = {key: jnp.asarray(value, jnp.float32) for key, value in values.items()}
+        starts.append(_scaled_from_params(params))
+    scaled, losses = _optimise(_stack(starts), jnp.asarray(masks), batch.inputs, batch.target, batch.weight,
+                               scales, floors, steps=settings.steps, learning_rate=settings.learning_rate)
+    sequence = np.concatenate([examples.sequence, np.full(len(batch.weight) - batch.count, -1)])
+    results = []
+    for k, candidate in enumerate(candidates):
+        one = jax.tree.map(lambda leaf: leaf[k], scaled)
+        params = jax.device_get(_params_from_scaled(one, jnp.asarray(masks[k])))
+        results.append(FitResult(
+            effects=candidate,
+            params={name: {key: np.asarray(value) for key, value in params[name].items()} for name in candidate},
+            physical=_physical_with_std(one, masks[k], batch, scales, floors, sequence, candidate),
+            loss=float(losses[k]),
+        ))
+    return results
+
+
+def _physical_with_std(scaled, mask, batch, scales, floors, sequence, candidate):
+    residual, jacobian = jax.device_get(_residual_jacobian(scaled, jnp.asarray(mask), batch.inputs, batch.target,
+                                                           scales))
+    floors = np.asarray(floors, np.float64)
+    used = sequence >= 0
+    residual, jacobian, sequence = residual[used].astype(np.float64), jacobian[used].astype(np.float64), sequence[used]
+    # Loss terms sqrt(|r_xy|^2 + f0^2) and sqrt(r_theta^2 + f1^2): gradients and Gauss-Newton curvatures.
+    planar = residual[:, :2]
+    spread_t = np.sum(planar ** 2, axis=1) + floors[0] ** 2
+    spread_r = residual[:, 2] ** 2 + floors[1] ** 2
+    d_loss = np.concatenate([planar / np.sqrt(spread_t)[:, None], (residual[:, 2] / np.sqrt(spread_r))[:, None]], 1)
+    curvature = np.zeros((len(residual), 3, 3))
+    curvature[:, :2, :2] = (np.eye(2)[None] * spread_t[:, None, None]
+                            - planar[:, :, None] * planar[:, None, :]) / spread_t[:, None, None] ** 1.5
+    curvature[:, 2, 2] = floors[1] ** 2 / spread_r ** 1.5
+    count = len(residual)
+    gradients = np.einsum("nkp,nk->np", jacobian, d_loss) / count
+    hessian = np.einsum("nkp,nkl,nlq->pq", jacobian, curvature, jacobian) / count
+    # The candidate's own variables (the masked ones have no effect and zero Jacobian).
+    active = np.flatnonzero(np.any(jacobian != 0, axis=(0, 1)))
+    ids, index = np.unique(sequence, return_inverse=True)
+    per_sequence = np.zeros((len(ids), len(active)))
+    np.add.at(per_sequence, index, gradients[:, active])
+    h = hessian[np.ix_(active, active)]
+    eigenvalues, eigenvectors = np.linalg.eigh(0.5 * (h + h.T))
+    floor = max(1e-12, 1e-9 * float(np.max(np.abs(eigenvalues), initial=0.0)))
+    inverse = eigenvectors @ np.diag(1.0 / np.maximum(np.abs(eigenvalues), floor)) @ eigenvectors.T
+    meat = per_sequence.T @ per_sequence * len(ids) / max(len(ids) - 1, 1)
+    covariance = inverse @ meat @ inverse
+    values, value_jacobian = jax.device_get(_physical_jacobian(scaled, jnp.asarray(mask)))
+    value_jacobian = np.asarray(value_jacobian, np.float64)[:, active]
+    std = np.sqrt(np.maximum(np.einsum("qp,pr,qr->q", value_jacobian, covariance, value_jacobian), 0.0))
+    physical = effects_lib.physical_params(jax.device_get(_params_from_scaled(scaled, jnp.asarray(mask))))
+    _, unravel = ravel_pytree(jax.tree.map(np.asarray, physical))
+    value_tree, std_tree = unravel(np.asarray(values)), unravel(std)
+    # A value whose derivative does not exist at the optimum (e.g. an axis at zero anisotropy) has no std.
+    return {name: {key: {"value": float(value_tree[name][key]),
+                         "std": float(std_tree[name][key]) if np.isfinite(std_tree[name][key]) else None}
+                   for key in value_tree[name]} for name in candidate}
+
+
+@jax.jit
+def _predict_many(scaled, masks, inputs):
+    return jax.vmap(lambda s, m: _FULL_MODEL(_params_from_scaled(s, m), inputs))(scaled, masks)
+
+
+def predict(results: Sequence[FitResult | None], examples: Examples) -> np.ndarray:
+    """[M, N, 3] predictions on ``examples`` of fitted models (None: the plain Lynch model)."""
+    batch = to_batch(examples)
+    slots = max(len(EFFECT_NAMES), len(results))
+    params = []
+    for result in list(results) + [None] * (slots - len(results)):
+        full = effects_lib.init_params()
+        for name, values in (result.params if result is not None else {}).items():
+            full[name] = {key: jnp.asarray(value, jnp.float32) for key, value in values.items()}
+        params.append(_scaled_from_params(full))
+    masks = jnp.ones((slots, len(EFFECT_NAMES)), jnp.float32)
+    prediction = _predict_many(_stack(params), masks, batch.inputs)
+    return np.asarray(prediction, np.float64)[:len(results), :batch.count]

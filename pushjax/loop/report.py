@@ -1,0 +1,157 @@
+"""Writing the loop's results: ``report.json`` (the issue's schema), ``details.json``, ``report.md`` and
+figures of the residual against the candidate variables."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from pushjax.loop import diagnose as diagnose_lib  # noqa: E402
+from pushjax.loop.examples import CATEGORICAL, VARIABLES, Examples  # noqa: E402
+from pushjax.loop.metrics import METRIC_KEYS  # noqa: E402
+
+FIGURE_DIR = "figures"
+
+
+def write_json(path: Path, value) -> None:
+    path.write_text(json.dumps(value, indent=2, allow_nan=False) + "\n")
+
+
+def residual_figure(path: Path, examples: Examples, prediction: np.ndarray, title: str,
+                    variables: list[str]) -> None:
+    """Median residual per bin of each variable: along and across the push (mm) and rotation (deg)."""
+    residual = examples.target - np.asarray(prediction, np.float64)
+    motion = np.asarray(examples.inputs.pusher_motion, np.float64)
+    angle = np.arctan2(motion[:, 1], motion[:, 0])
+    along = 1e3 * (np.cos(angle) * residual[:, 0] + np.sin(angle) * residual[:, 1])
+    across = 1e3 * (-np.sin(angle) * residual[:, 0] + np.cos(angle) * residual[:, 1])
+    rotation = np.degrees(residual[:, 2])
+    columns = min(len(variables), 4)
+    rows = max(1, math.ceil(len(variables) / max(columns, 1)))
+    figure, axes = plt.subplots(rows, max(columns, 1), figsize=(4 * max(columns, 1), 3 * rows), squeeze=False)
+    for axis in axes.flat[len(variables):]:
+        axis.set_visible(False)
+    for axis, name in zip(axes.flat, variables):
+        values = examples.variables[name]
+        labels, assign = diagnose_lib.assign_bins(values, VARIABLES[name])
+        bins = assign(values)
+        present = np.unique(bins)
+        if VARIABLES[name] == CATEGORICAL:
+            ticks = [str(labels[b]) for b in present]
+        else:
+            ticks = [f"{np.median(np.asarray(values, np.float64)[bins == b]):.3g}" for b in present]
+        x = np.arange(len(present))
+        for series, label in ((along, "along push, mm"), (across, "across push, mm"), (rotation, "rotation, deg")):
+            axis.plot(x, [np.median(series[bins == b]) for b in present], marker="o", label=label)
+        axis.axhline(0.0, color="black", linewidth=0.5)
+        axis.set_xticks(x, ticks, rotation=45, fontsize=7)
+        axis.set_title(name, fontsize=9)
+    axes.flat[0].legend(fontsize=7)
+    figure.suptitle(title)
+    figure.tight_layout()
+    figure.savefig(path, dpi=80)
+    plt.close(figure)
+
+
+def strength_figure(path: Path, before: list, after: list) -> None:
+    """Bar chart of each variable's strength before and after the fix."""
+    names = [d.variable for d in before]
+    after_by_name = {d.variable: d.strength for d in after}
+    y = np.arange(len(names))
+    figure, axis = plt.subplots(figsize=(7, 0.4 * len(names) + 1.2))
+    axis.barh(y - 0.2, [d.strength for d in before], height=0.4, label="plain model")
+    axis.barh(y + 0.2, [after_by_name[name] for name in names], height=0.4, label="after the fix")
+    axis.set_yticks(y, names, fontsize=8)
+    axis.invert_yaxis()
+    axis.axvline(0.0, color="black", linewidth=0.5)
+    axis.set_xlabel("share of the error a correction for the variable removes")
+    axis.legend(fontsize=8)
+    figure.tight_layout()
+    figure.savefig(path, dpi=80)
+    plt.close(figure)
+
+
+def _metrics_row(label: str, summary: dict) -> str:
+    return (f"| {label} | {summary['trans_pct']:.1f} | {summary['rot_pct']:.1f} | {summary['trans_mm']:.3f} "
+            f"| {summary['rot_deg']:.3f} | {summary['trans_pct'] + summary['rot_pct']:.1f} |")
+
+
+def _params_text(params: dict) -> str:
+    def spread(std):
+        return "?" if std is None else f"{std:.2g}"
+
+    return ", ".join(f"{name} = {value['value']:.4g} ± {spread(value['std'])}" for name, value in params.items()) or "-"
+
+
+def markdown(report: dict, details: dict) -> str:
+    """The readable report."""
+    header = "| model | translation % | rotation % | translation mm | rotation deg | sum % |\n|---|---|---|---|---|---|"
+    lines = [
+        "# Closing the loop: residual → effect → refit",
+        "",
+        f"Data: `{details['data_dir']}`, horizon {details['horizon']} s, seed {details['seed']}. "
+        f"Pushes: {report['n_pushes']['fit']} fit, {report['n_pushes']['heldout']} held out, "
+        f"{report['n_pushes']['skipped']} files skipped; {details['n_windows']['fit']} fit and "
+        f"{details['n_windows']['heldout']} held-out windows. Nominal model: uniform-pressure limit surface, "
+        f"pusher friction {details['pusher_friction']}. Errors are held-out means; % is relative to the "
+        "`zero` baseline (predicting no motion).",
+        "",
+        "## Before and after",
+        "",
+        header,
+        _metrics_row("plain Lynch model", report["baseline"]),
+        _metrics_row("selected: " + (" + ".join(report["selected"]) or "nothing"), report["after"]),
+    ]
+    if report["fallback"] is not None:
+        lines.append(_metrics_row("selected + learned error term", report["fallback"]["heldout"]))
+    lines += ["", "## Diagnosis of the plain model's residual", "",
+              "Strength: share of the translation + rotation error that a cross-fitted correction by the "
+              "variable's bins removes (see `pushjax.loop.diagnose`); lower: one-sided bootstrap bound.", "",
+              "| variable | strength | lower | axes | beyond noise |", "|---|---|---|---|---|"]
+    lines += [f"| {d['variable']} | {d['strength']:.3f} | {d['lower']:.3f} | {d['frame']} | {d['beyond_noise']} |"
+              for d in details["diagnosis_before"]]
+    lines += ["", f"![residual of the plain model]({FIGURE_DIR}/residual_baseline.png)", "",
+              "## Effects ranked by held-out error (each fitted alone)", "",
+              "| effect | parameters (± standard error) | sum % | translation mm | rotation deg |", "|---|---|---|---|---|"]
+    lines += [f"| {entry['effect']} | {_params_text(entry['params'])} | "
+              f"{entry['heldout']['trans_pct'] + entry['heldout']['rot_pct']:.1f} | {entry['heldout']['trans_mm']:.3f} | "
+              f"{entry['heldout']['rot_deg']:.3f} |" for entry in report["ranking"]]
+    lines += ["", "## Forward selection", "",
+              f"An effect is added when the lower bootstrap bound of its relative held-out gain exceeds "
+              f"{details['min_gain']:.2f}.", ""]
+    for k, round_ in enumerate(details["rounds"], 1):
+        best = max(round_["gains"], key=round_["gains"].get)
+        lines.append(f"{k}. best addition `{best}`: gain {round_['gains'][best]:+.3f}, lower bound "
+                     f"{round_['lower']:+.3f} → {'added' if round_['accepted'] else 'stop'}")
+    if report["selected"]:
+        lines += ["", "Fitted parameters of the selected model:", ""]
+        lines += [f"- {name}: {_params_text(params)}" for name, params in details["selected_params"].items()]
+    lines += ["", "## Residual after the fix", "",
+              "| variable | strength | lower | beyond noise |", "|---|---|---|---|"]
+    lines += [f"| {d['variable']} | {d['strength']:.3f} | {d['lower']:.3f} | {d['beyond_noise']} |"
+              for d in details["diagnosis_after"]]
+    lines += ["", f"![residual after the fix]({FIGURE_DIR}/residual_after.png)", "",
+              f"![strengths]({FIGURE_DIR}/diagnosis.png)", ""]
+    if report["explained"]:
+        lines.append("**Explained:** no variable explains a share of the remaining error beyond noise.")
+    else:
+        variable = details["unexplained_variable"]
+        lines.append(
+            f"**Not explained:** no library effect removes the structured residual. It still depends on "
+            f"**{variable['variable']}** (a correction for it removes {variable['strength']:.1%} of the error, "
+            f"lower bound {variable['lower']:.1%}). A learned error-correction term (MLP on the model's inputs) "
+            f"was fitted as a fallback: held-out sum {report['fallback']['heldout']['trans_pct'] + report['fallback']['heldout']['rot_pct']:.1f} % "
+            f"instead of {report['after']['trans_pct'] + report['after']['rot_pct']:.1f} %.")
+    return "\n".join(lines) + "\n"
+
+
+def as_summary(summary: dict) -> dict:
+    """The four error metrics as plain floats."""
+    return {key: float(summary[key]) for key in METRIC_KEYS}

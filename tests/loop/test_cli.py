@@ -1,0 +1,31 @@
+"""Tests of ``python -m experiments.close_loop``."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def run(*arguments):
+    return subprocess.run([sys.executable, "-m", "experiments.close_loop", *arguments], cwd=REPO,
+                          capture_output=True, text=True, timeout=600)
+
+
+def test_writes_the_report(record, tmp_path):
+    result = run(f"--data_dir={record('pressure')}", f"--workdir={tmp_path}", "--seed=3")
+    assert result.returncode == 0, result.stderr
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert report["selected"][:1] == ["friction_ratio"]
+    assert json.loads(result.stdout[:result.stdout.rindex("}") + 1])["selected"] == report["selected"]
+    assert (tmp_path / "report.md").is_file() and (tmp_path / "details.json").is_file()
+
+
+def test_missing_or_empty_data_dir_names_the_flag(tmp_path):
+    missing = run(f"--data_dir={tmp_path / 'nowhere'}", f"--workdir={tmp_path / 'out'}")
+    assert missing.returncode != 0 and "--data_dir" in missing.stderr and "not a directory" in missing.stderr
+    (tmp_path / "empty").mkdir()
+    empty = run(f"--data_dir={tmp_path / 'empty'}", f"--workdir={tmp_path / 'out'}")
+    assert empty.returncode != 0 and "--data_dir" in empty.stderr and "no push files" in empty.stderr
+    assert not (tmp_path / "out" / "report.json").exists()

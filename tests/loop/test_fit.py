@@ -1,0 +1,67 @@
+"""Tests of the effect fits, the forward selection and the error-correction fallback on synthetic
+targets: the windows of a recorded data set with targets predicted by a known augmented model."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from pushjax.data.mit_push import iter_pushes
+from pushjax.loop import correction, fit, metrics, select
+from pushjax.loop.examples import build_examples, split_by_sequence
+
+TRUE = {"cof_offset": {"offset": np.array([0.008, -0.004])},
+        "friction_ratio": {"log_scale": np.array(np.log(1.4))}}
+
+
+@pytest.fixture(scope="module")
+def synthetic(record):
+    """Examples whose targets follow cof_offset + friction_ratio, plus 0.2 mm / 0.2 deg noise."""
+    examples, _ = build_examples(iter_pushes(record("clean")))
+    truth = fit.FitResult(effects=tuple(TRUE), params=TRUE, physical={}, loss=0.0)
+    target = fit.predict([truth], examples)[0]
+    noise = np.random.default_rng(0).normal(size=target.shape) * np.array([2e-4, 2e-4, np.radians(0.2)])
+    return dataclasses.replace(examples, target=target + noise)
+
+
+def test_fits_several_candidates_at_once_and_recovers_the_parameters(synthetic):
+    train, heldout = split_by_sequence(synthetic, 0.3, seed=0)
+    results = fit.fit_effects([("friction_ratio", "cof_offset"), ("cof_offset",), ("table_tilt",)], train)
+    assert [r.effects for r in results] == [("cof_offset", "friction_ratio"), ("cof_offset",), ("table_tilt",)]
+    both = results[0]
+    np.testing.assert_allclose(both.params["cof_offset"]["offset"], TRUE["cof_offset"]["offset"], atol=5e-4)
+    np.testing.assert_allclose(both.params["friction_ratio"]["log_scale"], np.log(1.4), atol=0.03)
+    scale = both.physical["friction_ratio"]["scale"]
+    assert 0 < scale["std"] < 0.05 and abs(scale["value"] - 1.4) < 5 * scale["std"] + 0.01
+    offset = both.physical["cof_offset"]["offset_x_mm"]
+    assert 0 < offset["std"] < 1.0 and abs(offset["value"] - 8.0) < 5 * offset["std"] + 0.1
+    assert both.loss < results[1].loss < results[2].loss
+    predictions = fit.predict([None, *results], heldout)
+    scores = [metrics.combined(metrics.summarize(metrics.window_errors(p, heldout.target, heldout.sequence)))
+              for p in predictions]
+    assert scores[1] < 0.3 * scores[0] and scores[1] < scores[2] < scores[0]
+
+
+def test_forward_selection_adds_both_effects_and_stops(synthetic):
+    train, heldout = split_by_sequence(synthetic, 0.3, seed=1)
+    selection = select.select_effects(train, heldout, n_bootstrap=300)
+    assert sorted(selection.selected) == ["cof_offset", "friction_ratio"]
+    assert selection.rounds[-1].accepted is None and len(selection.rounds) == 3
+    assert selection.ranking[0].effects[0] in TRUE
+    assert selection.final.score < 0.5 * selection.baseline.score
+
+
+def test_error_correction_learns_what_the_model_misses(synthetic):
+    train, heldout = split_by_sequence(synthetic, 0.3, seed=2)
+    plain_train, plain_heldout = fit.predict([None], train)[0], fit.predict([None], heldout)[0]
+    term = correction.fit_error_correction(train, plain_train, correction.CorrectionSettings(steps=600), seed=0)
+    before = metrics.combined(metrics.summarize(metrics.window_errors(plain_heldout, heldout.target, heldout.sequence)))
+    corrected = term(heldout, plain_heldout)
+    after = metrics.combined(metrics.summarize(metrics.window_errors(corrected, heldout.target, heldout.sequence)))
+    assert after < 0.8 * before
+    np.testing.assert_array_equal(term(heldout, plain_heldout), corrected)
+
+
+def test_unknown_effects_are_rejected(synthetic):
+    with pytest.raises(ValueError, match="unknown 'wind'"):
+        fit.fit_effects([("wind",)], synthetic)

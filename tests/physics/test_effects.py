@@ -1,0 +1,280 @@
+"""Tests of the effect library: no-effect defaults, differentiability, and the physics of each effect."""
+
+import itertools
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from pushjax.physics import effects, lynch
+
+
+def _unit(angle):
+    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+
+
+def _random_inputs(seed, count=5000, dtype=np.float32):
+    """Pushes covering sticking, slipping both ways, pulling, far contacts, stops and no contact."""
+    rng = np.random.default_rng(seed)
+    l = rng.uniform(0.02, 0.06, count)
+    contact = _unit(rng.uniform(-np.pi, np.pi, count)) * (l * rng.uniform(0, 2, count))[:, None]
+    normal_angle = rng.uniform(-np.pi, np.pi, count)
+    normal = _unit(normal_angle) * (rng.uniform(size=count) > 0.05)[:, None]
+    action = _unit(normal_angle + rng.uniform(-1.1, 1.1, count) * np.pi / 2) * rng.uniform(1e-4, 0.02, count)[:, None]
+    motion = action * rng.uniform(1, 1.5, count)[:, None]
+    values = dict(contact=contact, normal=normal, action=action, l=l, mu=rng.uniform(0, 1.5, count),
+                  s=(rng.uniform(size=count) > 0.1).astype(float), pusher_motion=motion,
+                  gap=rng.uniform(-0.002, 0.005, count), object_yaw=rng.uniform(-np.pi, np.pi, count),
+                  push_speed=rng.uniform(0.01, 0.5, count), time_after_stop=rng.uniform(0, 0.5, count)
+                  * (rng.uniform(size=count) > 0.5))
+    return effects.PushInputs(**{name: jnp.asarray(value, dtype) for name, value in values.items()})
+
+
+def _cross(a, b):
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _lynch(inputs):
+    return lynch.predict(inputs.contact, inputs.normal, inputs.action, inputs.l, inputs.mu, inputs.s)
+
+
+def _random_params(seed):
+    rng = np.random.default_rng(seed)
+    return {
+        "frame_offset": {"offset": jnp.asarray(rng.normal(0, 0.005, 2), jnp.float32)},
+        "cof_offset": {"offset": jnp.asarray(rng.normal(0, 0.005, 2), jnp.float32)},
+        "friction_ratio": {"log_scale": jnp.asarray(rng.normal(0, 0.3), jnp.float32)},
+        "anisotropic_friction": {"log_metric": jnp.asarray(rng.normal(0, 0.4, 2), jnp.float32)},
+        "pusher_friction": {"log_scale": jnp.asarray(rng.normal(0, 0.3), jnp.float32)},
+        "table_tilt": {"drift_force": jnp.asarray(rng.normal(0, 0.2, 2), jnp.float32)},
+        "inertia": {"inverse_deceleration": jnp.asarray(rng.uniform(0, 1), jnp.float32)},
+    }
+
+
+@pytest.mark.parametrize("names", [(), *[(name,) for name in effects.EFFECT_NAMES], effects.EFFECT_NAMES])
+def test_no_effect_parameters_reproduce_lynch(names):
+    inputs = _random_inputs(0)
+    predicted = jax.jit(effects.compose(names))(effects.init_params(names), inputs)
+    np.testing.assert_allclose(predicted, _lynch(inputs), rtol=0, atol=1e-7)
+
+
+def test_generalised_solver_is_lynch_for_isotropic_friction_in_float64():
+    with jax.enable_x64(True):
+        inputs = _random_inputs(1, dtype=np.float64)
+        expected = np.asarray(_lynch(inputs))
+        predicted = np.asarray(effects.limit_surface_predict(inputs.contact, inputs.normal, inputs.action, inputs.l,
+                                                             inputs.mu, inputs.s))
+    np.testing.assert_allclose(predicted, expected, rtol=0, atol=1e-13 * np.abs(expected).max())
+
+
+def test_gradients_are_finite_at_no_effect_and_degenerate_inputs():
+    inputs = _random_inputs(2, count=64)
+    zero = jnp.zeros_like(inputs.normal)
+    degenerate = [inputs, inputs.replace(normal=zero), inputs.replace(action=zero, pusher_motion=zero),
+                  inputs.replace(s=jnp.zeros_like(inputs.s)), inputs.replace(contact=zero)]
+    model = effects.compose(effects.EFFECT_NAMES)
+    for case, params in itertools.product(degenerate, (effects.init_params(), _random_params(3))):
+        gradient = jax.grad(lambda p, i: jnp.sum(model(p, i) ** 2), argnums=(0, 1))(params, case)
+        assert all(np.all(np.isfinite(leaf)) for leaf in jax.tree.leaves(gradient))
+
+
+def test_gradient_at_no_effect_points_somewhere_for_every_effect():
+    inputs = _random_inputs(4, count=2000)
+    target = effects.compose(effects.EFFECT_NAMES)(_random_params(5), inputs)
+    model = effects.compose(effects.EFFECT_NAMES)
+    gradient = jax.grad(lambda p: jnp.sum((model(p, inputs) - target) ** 2))(effects.init_params())
+    for name in effects.EFFECT_NAMES:
+        assert any(np.any(np.asarray(leaf) != 0) for leaf in jax.tree.leaves(gradient[name])), name
+
+
+def test_composition_order_does_not_matter_and_names_are_checked():
+    inputs = _random_inputs(6, count=500)
+    params = _random_params(7)
+    forward = effects.compose(effects.EFFECT_NAMES)(params, inputs)
+    backward = effects.compose(effects.EFFECT_NAMES[::-1])(params, inputs)
+    np.testing.assert_array_equal(forward, backward)
+    with pytest.raises(ValueError, match="unknown 'gravity'"):
+        effects.compose(["gravity"])
+    with pytest.raises(ValueError, match="missing parameters of cof_offset"):
+        effects.compose(["cof_offset"])({}, inputs)
+
+
+def test_vmaps_over_parameter_sets():
+    inputs = _random_inputs(8, count=300)
+    model = effects.compose(effects.EFFECT_NAMES)
+    stacked = jax.tree.map(lambda *leaves: jnp.stack(leaves), *(_random_params(seed) for seed in range(3)))
+    batched = jax.jit(jax.vmap(model, in_axes=(0, None)))(stacked, inputs)
+    for k in range(3):
+        np.testing.assert_allclose(batched[k], model(_random_params(k), inputs), rtol=1e-5, atol=1e-7)
+
+
+def test_friction_ratio_and_pusher_friction_scale_l_and_mu():
+    inputs = _random_inputs(9)
+    scale = np.float32(1.7)
+    log = {"log_scale": jnp.log(scale)}
+    np.testing.assert_allclose(
+        effects.compose(["friction_ratio"])({"friction_ratio": log}, inputs),
+        lynch.predict(inputs.contact, inputs.normal, inputs.action, inputs.l * scale, inputs.mu, inputs.s), atol=1e-7)
+    np.testing.assert_allclose(
+        effects.compose(["pusher_friction"])({"pusher_friction": log}, inputs),
+        lynch.predict(inputs.contact, inputs.normal, inputs.action, inputs.l, inputs.mu * scale, inputs.s), atol=1e-7)
+
+
+def test_push_through_the_centre_of_friction_translates_it_without_rotation():
+    offset = np.array([0.01, -0.005])
+    yaw = 0.7
+    centre_world = np.array([np.cos(yaw) * offset[0] - np.sin(yaw) * offset[1],
+                             np.sin(yaw) * offset[0] + np.cos(yaw) * offset[1]])
+    normal = np.array([1.0, 0.0])
+    contact = centre_world - 0.03 * normal
+    inputs = effects.PushInputs.create(contact, normal, 0.01 * normal, 0.03, 0.3, object_yaw=yaw)
+    twist = effects.compose(["cof_offset"])({"cof_offset": {"offset": jnp.asarray(offset)}}, inputs)
+    np.testing.assert_allclose(twist, [0.01, 0.0, 0.0], atol=1e-8)
+    # Without the offset the same push is off-centre and turns the object.
+    assert abs(float(_lynch(inputs)[2])) > 0.01
+
+
+def test_frame_offset_moves_the_contact_along_the_side_and_delays_it():
+    # Flat side facing -x at x = -0.04 (object yaw 0): the pusher moves +x by 10 mm and touches after 2 mm.
+    normal = np.array([1.0, 0.0])
+    motion = np.array([0.01, 0.0])
+    inputs = effects.PushInputs.create([-0.04, 0.01], normal, 0.8 * motion, 0.03, 10.0, pusher_motion=motion,
+                                       gap=0.002)
+    model = effects.compose(["frame_offset"])
+    # The tracked frame sits at (-3, +4) mm in the geometry's frame, so the true outline is (+3, -4) mm
+    # from the annotated one: the side is reached 3 mm later (after half the motion) and the contact lies
+    # 4 mm further along +y from the true centre, which the reported point trails by (-3, +4) mm.
+    twist = model({"frame_offset": {"offset": jnp.asarray([-0.003, 0.004])}}, inputs)
+    centre_twist = lynch.predict(jnp.asarray([-0.04, 0.014]), normal, 0.5 * motion, 0.03, 10.0)
+    omega = centre_twist[2]
+    expected = centre_twist + jnp.asarray([omega * -0.004, omega * -0.003, 0.0])
+    np.testing.assert_allclose(twist, expected, rtol=1e-6, atol=1e-9)
+    # Moved the other way, the side is touched from the start: the whole motion pushes.
+    closer = model({"frame_offset": {"offset": jnp.asarray([0.003, 0.0])}}, inputs)
+    centre_twist = lynch.predict(jnp.asarray([-0.04, 0.01]), normal, motion, 0.03, 10.0)
+    expected = centre_twist + jnp.asarray([0.0, centre_twist[2] * 0.003, 0.0])
+    np.testing.assert_allclose(closer, expected, rtol=1e-6, atol=1e-9)
+
+
+def test_frame_offset_brings_a_contact_beyond_the_window_into_it():
+    # The annotated side is 12 mm ahead of a pusher that moves 10 mm: no contact (s = 0, no action), but
+    # with the outline really 4 mm closer the pusher touches after 8 mm and pushes for 2 mm.
+    normal = np.array([1.0, 0.0])
+    motion = np.array([0.01, 0.0])
+    inputs = effects.PushInputs.create([-0.04, 0.0], normal, np.zeros(2), 0.03, 10.0, s=0.0, pusher_motion=motion,
+                                       gap=0.012)
+    model = effects.compose(["frame_offset"])
+    np.testing.assert_array_equal(model(effects.init_params(["frame_offset"]), inputs), 0.0)
+    twist = model({"frame_offset": {"offset": jnp.asarray([0.004, 0.0])}}, inputs)
+    centre_twist = lynch.predict(jnp.asarray([-0.04, 0.0]), normal, 0.2 * motion, 0.03, 10.0)
+    np.testing.assert_allclose(twist, centre_twist, rtol=1e-6, atol=1e-9)
+    assert float(twist[0]) > 0.0019
+
+
+def test_anisotropic_friction_deflects_a_push_towards_the_weak_axis():
+    # A frictionless push through the centre at 45 degrees to the object's axes, friction twice as strong
+    # along y: the object translates along A_f n = (2, 1/2) / sqrt(2), deflected towards x, without turning.
+    normal = _unit(np.pi / 4)
+    inputs = effects.PushInputs.create(-0.03 * normal, normal, 0.01 * normal, 0.03, 0.0)
+    log_metric = jnp.asarray([np.log(2.0), 0.0])  # A_xx = 2: x is the weak axis (f_max smaller along x)
+    model = effects.compose(["anisotropic_friction"])
+    twist = np.asarray(model({"anisotropic_friction": {"log_metric": log_metric}}, inputs))
+    assert abs(twist[2]) < 1e-9
+    np.testing.assert_allclose(twist[0] / twist[1], 4.0, rtol=1e-5)
+    physical = effects.physical_params({"anisotropic_friction": {"log_metric": log_metric}})["anisotropic_friction"]
+    np.testing.assert_allclose([physical["ratio"], physical["strong_axis_deg"]], [2.0, 90.0], rtol=1e-6)
+    # Turning the object by 90 degrees turns the weak axis with it.
+    turned = np.asarray(model({"anisotropic_friction": {"log_metric": log_metric}},
+                              inputs.replace(object_yaw=jnp.asarray(np.pi / 2))))
+    np.testing.assert_allclose(turned[1] / turned[0], 4.0, rtol=1e-5)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_generalised_solver_satisfies_the_contact_and_limit_surface_conditions(seed):
+    with jax.enable_x64(True):
+        inputs = _random_inputs(seed, count=4000, dtype=np.float64)
+        rng = np.random.default_rng(seed)
+        s_matrix = rng.normal(0, 0.4, (len(inputs.l), 2))
+        params = {"anisotropic_friction": {"log_metric": jnp.asarray(s_matrix[0])},
+                  "table_tilt": {"drift_force": jnp.asarray(rng.normal(0, 0.25, 2))}}
+        state = effects.ModelState(contact=inputs.contact, normal=inputs.normal, action=inputs.action, l=inputs.l,
+                                   mu=inputs.mu, s=jnp.ones_like(inputs.s), centre=jnp.zeros_like(inputs.contact),
+                                   metric=(jnp.ones_like(inputs.l), jnp.zeros_like(inputs.l), jnp.ones_like(inputs.l)),
+                                   drift_force=jnp.zeros_like(inputs.contact))
+        for name in ("anisotropic_friction", "table_tilt"):
+            state = effects.EFFECTS[name].modify(params[name], state, inputs)
+        twist = np.asarray(effects.limit_surface_predict(state.contact, state.normal, state.action, state.l, state.mu,
+                                                         state.s, state.metric, state.drift_force))
+    c, n, u, l, mu = (np.asarray(x) for x in (inputs.contact, inputs.normal, inputs.action, inputs.l, inputs.mu))
+    metric = np.stack([np.stack([state.metric[0], state.metric[1]], -1),
+                       np.stack([state.metric[1], state.metric[2]], -1)], -2)
+    g = np.asarray(state.drift_force)
+    contact_velocity = twist[:, :2] + twist[:, 2:3] * np.stack([-c[:, 1], c[:, 0]], -1)
+    moving = np.linalg.norm(twist, axis=1) > 0
+    assert moving.mean() > 0.5
+    # The wrench F = (f + g, c x f) with V = kappa A F: recover kappa from the torque balance.
+    force_direction = np.linalg.solve(metric, twist[:, :2, None])[..., 0]  # = kappa (f + g)
+    torque = l ** 2 * twist[:, 2]  # = kappa (c x f)
+    lever = _cross(c, g)
+    valid = moving & (np.abs(lever) > 1e-3 * np.linalg.norm(c, axis=1) * np.linalg.norm(g, axis=1))
+    kappa = (_cross(c, force_direction) - torque)[valid] / lever[valid]
+    assert np.all(kappa > 0)
+    f = force_direction[valid] / kappa[:, None] - g[valid]
+    wrench_force = f + g[valid]
+    on_surface = np.einsum("ni,nij,nj->n", wrench_force, metric[valid], wrench_force) + (
+        _cross(c[valid], f) / l[valid]) ** 2
+    np.testing.assert_allclose(on_surface, 1.0, atol=1e-6)
+    # Friction cone: |n x f| <= mu n.f; sticking contacts follow the pusher, slipping ones its normal motion.
+    n_valid = n[valid]
+    assert np.all(np.abs(_cross(n_valid, f)) <= mu[valid] * np.sum(n_valid * f, 1) * (1 + 1e-6) + 1e-9)
+    sticking = np.all(np.isclose(contact_velocity[valid], u[valid], rtol=0, atol=1e-9), axis=1)
+    assert 0.2 < sticking.mean() < 0.9
+    np.testing.assert_allclose(np.sum(contact_velocity[valid] * n_valid, 1), np.sum(u[valid] * n_valid, 1), atol=1e-9)
+
+
+def test_table_tilt_needs_a_push_and_scales_with_it():
+    inputs = _random_inputs(10, count=1000)
+    params = {"table_tilt": {"drift_force": jnp.asarray([0.3, -0.1])}}
+    model = effects.compose(["table_tilt"])
+    still = model(params, inputs.replace(action=jnp.zeros_like(inputs.action)))
+    np.testing.assert_array_equal(still, 0.0)
+    np.testing.assert_allclose(model(params, inputs.replace(action=2 * inputs.action)), 2 * model(params, inputs),
+                               rtol=1e-5, atol=1e-9)
+    # A sticking push turns the object about the contact (the contact keeps following the pusher).
+    push = effects.PushInputs.create([-0.03, 0.0], [1.0, 0.0], [0.01, 0.0], 0.03, 10.0)
+    twist = np.asarray(model(params, push))
+    np.testing.assert_allclose(twist[:2] + twist[2] * np.array([0.0, -0.03]), [0.01, 0.0], atol=1e-8)
+    assert twist[1] < 0  # the drift force points -y: the object swings that way
+
+
+def test_inertia_slides_on_after_the_pusher_stops():
+    normal = np.array([1.0, 0.0])
+    action = np.array([0.02, 0.0])
+    inverse_deceleration = 0.5  # a = 2 m/s^2
+    params = {"inertia": {"inverse_deceleration": jnp.asarray(inverse_deceleration)}}
+    model = effects.compose(["inertia"])
+    speed = 0.4
+
+    def displacement(time_after_stop):
+        inputs = effects.PushInputs.create([-0.03, 0.0], normal, action, 0.03, 10.0, push_speed=speed,
+                                           time_after_stop=time_after_stop)
+        return np.asarray(model(params, inputs))
+
+    np.testing.assert_allclose(displacement(0.0), [0.02, 0.0, 0.0], atol=1e-9)
+    # Stops after v / a = 0.2 s, having slid v^2 / (2 a) = 40 mm; after 0.1 s: v t - a t^2 / 2 = 30 mm.
+    np.testing.assert_allclose(displacement(0.5), [0.06, 0.0, 0.0], atol=1e-8)
+    np.testing.assert_allclose(displacement(0.1), [0.05, 0.0, 0.0], atol=1e-8)
+    # Without a stop in the window the decay length does not matter, not even to first order at 0.
+    for time_after_stop, expected in ((0.0, 0.0), (0.5, 0.5 * speed ** 2)):
+        inputs = effects.PushInputs.create([-0.03, 0.0], normal, action, 0.03, 10.0, push_speed=speed,
+                                           time_after_stop=time_after_stop)
+        gradient = jax.grad(lambda inverse: model({"inertia": {"inverse_deceleration": inverse}}, inputs)[0])(0.0)
+        np.testing.assert_allclose(gradient, expected, rtol=1e-6)
+
+
+def test_projection_keeps_parameters_physical():
+    projected = effects.project_params({"inertia": {"inverse_deceleration": jnp.asarray(-1.0)},
+                                        "table_tilt": {"drift_force": jnp.asarray([3.0, 4.0])}})
+    assert float(projected["inertia"]["inverse_deceleration"]) == 0.0
+    np.testing.assert_allclose(projected["table_tilt"]["drift_force"], [0.57, 0.76], rtol=1e-6)
