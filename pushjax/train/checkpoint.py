@@ -7,11 +7,23 @@ complete one.
 
 from __future__ import annotations
 
+import logging
 import os
 from typing import Any
 
 import jax
 import orbax.checkpoint as ocp
+from absl import logging as absl_logging
+
+
+class _OrbaxInfoFilter(logging.Filter):
+    """Drops orbax's per-save INFO lines (hundreds per run) from the absl log; warnings pass."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return record.levelno >= logging.WARNING or f"{os.sep}orbax{os.sep}" not in record.pathname
+
+
+absl_logging.get_absl_logger().addFilter(_OrbaxInfoFilter())
 
 
 class Checkpointer:

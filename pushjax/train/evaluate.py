@@ -12,6 +12,7 @@
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping
 
 import jax
@@ -40,15 +41,20 @@ def predict(
     fields = model_fields(model.config)
     count = len(examples[fields[0]])
     variables = {"params": state.params, "batch_stats": state.batch_stats}
-    apply = jax.jit(
-        lambda variables, batch: model.apply(variables, batch, train=False, error_options=error_options)
-    )
     chunks = []
     for start in range(0, count, batch_size):
         indices = np.minimum(np.arange(start, start + batch_size), count - 1)
-        outputs = apply(variables, {name: examples[name][indices] for name in fields})
+        outputs = _apply_eval(model, variables, {name: examples[name][indices] for name in fields},
+                              error_options)
         chunks.append(jax.tree.map(lambda x, n=min(batch_size, count - start): np.asarray(x)[:n], outputs))
     return {name: np.concatenate([chunk[name] for chunk in chunks]) for name in chunks[0]}
+
+
+@functools.partial(jax.jit, static_argnames="model")
+def _apply_eval(model: PushModel, variables, batch, error_options):
+    # Module-level and keyed on the (hashable) model config, so every model, seed and test split
+    # of a sweep shares one compilation.
+    return model.apply(variables, batch, train=False, error_options=error_options)
 
 
 def _angle_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:

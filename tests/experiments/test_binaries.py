@@ -1,0 +1,108 @@
+"""Every experiment binary end to end at smoke scale (a few training steps), and its usage errors."""
+
+import json
+import math
+
+import pytest
+from absl import app
+
+from .conftest import run_binary
+
+
+def _strict_json(path):
+    def reject(constant):
+        raise ValueError(f"{path}: non-standard JSON constant {constant}")
+
+    return json.loads(path.read_text(), parse_constant=reject)
+
+
+def _check_results(workdir, name, models, pngs):
+    results = _strict_json(workdir / "results.json")
+    assert results["name"] == name
+    assert results["config"]["scale"] == "smoke"
+    assert results["config"]["dataset"]["scale"] == "smoke"
+    assert {row["model"] for row in results["rows"]} == set(models)
+    for row in results["rows"]:
+        for metric in ("trans_percent", "trans_percent_se", "rot_percent", "rot_percent_se"):
+            assert math.isfinite(row[metric]), (row["model"], metric)
+    table = (workdir / "results.md").read_text()
+    assert all(f"| {model} |" in table for model in models)
+    for png in pngs:
+        assert (workdir / png).read_bytes()[:4] == b"\x89PNG"
+    return results
+
+
+def test_data_efficiency_clips_sizes_and_writes_tables(smoke_results):
+    tmp_path = smoke_results("data_efficiency")
+    results = _check_results(tmp_path, "data_efficiency", ("hybrid", "neural_dyn", "zero", "physics"),
+                             ["fig5_data_efficiency.png"])
+    train_size = {row["train_size"] for row in results["rows"] if row["kind"] == "trained"}
+    assert min(train_size) == 20 and max(train_size) < 1_000_000
+    physics = next(row for row in results["rows"] if row["model"] == "physics")
+    assert physics["trans_percent"] < 50  # Lynch's model on the true state beats predicting no motion
+    assert "Table 2" in (tmp_path / "results.md").read_text()
+
+
+def test_new_pushes(smoke_results):
+    tmp_path = smoke_results("new_pushes")
+    _check_results(tmp_path, "new_pushes", ("hybrid", "zero"), ["new_pushes.png"])
+
+
+def test_velocities(smoke_results):
+    tmp_path = smoke_results("velocities")
+    results = _check_results(tmp_path, "velocities", ("hybrid", "physics"), ["fig6_velocities.png"])
+    assert {row["train_split"] for row in results["rows"] if row["kind"] == "trained"} == {
+        "train_20", "train_10_20", "train_20_50"}
+    assert len({row["test_split"] for row in results["rows"]}) == 8
+
+
+def test_objects(smoke_results):
+    tmp_path = smoke_results("objects")
+    results = _check_results(tmp_path, "objects", ("hybrid", "zero"), ["fig7_objects.png"])
+    assert {row["test_split"] for row in results["rows"]} == {"test_ellipses", "test_triangles"}
+
+
+def test_error_variants_scales_l(smoke_results):
+    tmp_path = smoke_results("error_variants")
+    results = _check_results(tmp_path, "error_variants", ("error", "error_grad", "physics"),
+                             ["fig9_error_variants.png", "table5_wrong_l.png"])
+    scaled = {(row["model"], row["l_scale"]) for row in results["rows"]}
+    assert scaled == {(m, 1.0) for m in ("error", "error_grad", "physics")} | {
+        (m, s) for m in ("error", "physics") for s in (1.5, 3.0)}
+    physics = {row["l_scale"]: row["trans_percent"] for row in results["rows"] if row["model"] == "physics"}
+    assert physics[3.0] > physics[1.0]  # a wrong limit-surface ratio hurts the analytical model
+
+
+def test_viewpoint(smoke_results):
+    tmp_path = smoke_results("viewpoint")
+    results = _check_results(tmp_path, "viewpoint", ("hybrid", "zero", "physics"), ["viewpoint.png"])
+    assert results["config"]["dataset"]["camera"] == "free"
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (("--variants=hybrid,transformer",), "transformer"),
+    (("--sizes=100,-5",), "sizes"),
+    (("--sizes=ten",), "sizes"),
+    (("--sizes=0",), "sizes"),
+    (("--data_dir=/nonexistent/pushjax",), "data_dir"),
+])
+def test_bad_flags_are_usage_errors(tmp_path, arguments, message):
+    with pytest.raises(app.UsageError, match=message):
+        run_binary("data_efficiency", "--scale=smoke", f"--workdir={tmp_path}", *arguments)
+
+
+def test_clipped_sizes_warn():
+    from pushjax.experiments import runner
+
+    with pytest.warns(UserWarning, match=r"exceed the 100 examples of training split 'train'; clipped to 100"):
+        assert runner.clip_sizes([50, 200, 300], 100) == (50, 100)
+
+
+def test_missing_workdir_is_a_usage_error():
+    with pytest.raises(app.UsageError, match="workdir"):
+        run_binary("data_efficiency", "--scale=smoke")
+
+
+def test_visualize(smoke_results):
+    tmp_path = smoke_results("visualize")
+    _check_results(tmp_path, "visualize", ("hybrid", "neural"), ["fig8_repeated_pushes.png"])
