@@ -1,9 +1,9 @@
-"""Sweep trainer: K models in one jit-compiled step against K sequential runs.
+"""Sweep trainer: K models in one sweep against K separate runs.
 
 Trains K = len(sizes) * len(seeds) models (a random training subset per size and seed) of one variant
 on the smoke ``data_efficiency`` dataset (built under ``--data_dir`` on first use): as K one-model
-runs one after another, and as one sweep with ``pushjax.train.sweep(mode="vmap")`` and
-``mode="unroll"``. Prints the wall time of each (compilation included, as a user sees it) and the
+runs one after another, and as one sweep with ``pushjax.train.sweep`` in each mode (``vmap``,
+``unroll``: one jitted step for all K models; ``sequential``: the single-model step per model). Prints the wall time of each (compilation included, as a user sees it) and the
 steady-state time per step of all K models (compilation excluded: the time from the end of step 10 on).
 
     python benchmarks/sweep.py [--variant=hybrid] [--scale=smoke] [--sizes=100,300] [--seeds=0,1]
@@ -45,7 +45,7 @@ def _timed_sweep(config, examples, specs, mode):
             marks[step] = time.perf_counter()
 
     start = time.perf_counter()
-    if mode != "sequential":
+    if mode != "separate":
         result = train.sweep(config, examples, specs, mode=mode, progress=False, step_callback=mark)
         jax.block_until_ready(result.state)
         total = time.perf_counter() - start
@@ -70,18 +70,19 @@ def main(argv):
     specs = train.subset_specs(
         len(examples["motion"]), [int(s) for s in _SIZES.value], [int(s) for s in _SEEDS.value]
     )
-    # Sequential baseline: K one-model runs, as `experiments.train` does for a single model; the step
+    # Baseline: K separate one-model runs, as `experiments.train` does for a single model; the step
     # is compiled once and reused (a separate process per run would compile K times).
-    timings = {mode: _timed_sweep(config, examples, specs, mode) for mode in ("sequential", "vmap", "unroll")}
-    sequential_total, sequential_step = timings["sequential"]
+    timings = {mode: _timed_sweep(config, examples, specs, mode) for mode in ("separate", *train.SWEEP_MODES)}
+    separate_total, separate_step = timings["separate"]
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, jax {jax.__version__}, "
           f"{jax.devices()[0].platform}; variant {_VARIANT.value}, scale {_SCALE.value}, K = {len(specs)} models, "
           f"{config.num_steps} steps, batch {config.batch_size}, images {examples['depth'].shape[1:3]}")
-    print("| mode | total s (incl. compile) | ms per step of all K models (steady) | speed-up total / steady |")
+    print("| mode | total s (incl. compile) | ms per step of all K models (steady) | speed-up total / steady "
+          "over separate runs |")
     print("|---|---|---|---|")
     for mode, (total, step) in timings.items():
         print(f"| {mode} | {total:.1f} | {1000 * step:.1f} | "
-              f"{sequential_total / total:.2f}x / {sequential_step / step:.2f}x |")
+              f"{separate_total / total:.2f}x / {separate_step / step:.2f}x |")
 
 
 if __name__ == "__main__":

@@ -25,7 +25,7 @@ NUM_STEPS = flags.DEFINE_integer("num_steps", None, "Override the scale's number
 DATA_DIR = flags.DEFINE_string("data_dir", None, "TFDS data directory, must exist (default: TFDS's).")
 BUILD = flags.DEFINE_bool("build", True, "Build the dataset when it is missing.")
 WORKERS = flags.DEFINE_integer("workers", None, "Dataset build processes (default: the builder's).")
-MODE = flags.DEFINE_enum("mode", None, train_lib.SWEEP_MODES, "Sweep batching (default: unroll on CPU, else vmap).")
+MODE = flags.DEFINE_enum("mode", None, train_lib.SWEEP_MODES, "Sweep batching (default: sequential on CPU, else vmap).")
 VARIANTS_FLAG = flags.DEFINE_list("variants", [], "Models to train and baselines (default: the experiment's).")
 
 

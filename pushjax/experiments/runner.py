@@ -120,8 +120,8 @@ def example_fields(config: train_configs.TrainConfig) -> tuple[str, ...]:
 
 
 def default_mode() -> str:
-    """The sweep mode that is fastest on this backend: ``unroll`` on CPU, else ``vmap``."""
-    return "unroll" if jax.default_backend() == "cpu" else "vmap"
+    """The sweep mode that is fastest on this backend: ``sequential`` on CPU, else ``vmap``."""
+    return "sequential" if jax.default_backend() == "cpu" else "vmap"
 
 
 def train_and_evaluate(

@@ -3,11 +3,13 @@
 A sweep trains K models that share one parameter structure (one `ModelConfig`), each on its own
 training subset (`ModelSpec.train_indices`) with its own seed, e.g. several random subsets for each
 of several training-set sizes (the paper averages over datasets of the same size), optionally mixing
-the error-term variants. One jit-compiled step updates all K models at once: ``mode="vmap"`` (the
-default) vmaps the single-model step over the model axis; ``mode="unroll"`` repeats it K times inside
-the one step, which is faster on XLA:CPU, where a vmapped convolution with per-model kernels becomes a
-slow grouped convolution (see ``benchmarks/sweep.py``); ``mode="sequential"`` trains the models one
-after another (for comparisons).
+the error-term variants. ``mode="vmap"`` (the default) updates all K models with one jit-compiled step,
+the single-model step vmapped over the model axis; ``mode="unroll"`` repeats the single-model step K
+times inside the one jitted step; ``mode="sequential"`` calls the jitted single-model step once per
+model at every step. On XLA:CPU a vmapped convolution with per-model kernels becomes a slow grouped
+convolution, and one model's convolutions already keep both cores busy, so ``sequential`` is the
+fastest there (``benchmarks/sweep.py``, ``benchmarks/sweep_breakdown.py``). All modes checkpoint
+the same stacked state, so a sweep can resume in another mode.
 
 Determinism: model k is initialised from ``jax.random.key(spec.seed)``; its batch at step t is a pure
 function of (spec.seed, spec.train_indices, t) (`batch_indices`), so a sweep resumed from a checkpoint
@@ -366,12 +368,12 @@ def sweep(
         least `model_fields`).
       specs: the models (subsets and seeds).
       workdir: folder for checkpoints and ``metrics.csv``; when it holds a checkpoint of the same
-        specs, training resumes from it. None: no checkpoints, no log (not used by "sequential").
-      mode: "vmap" or "unroll": one jitted step for all K models (see the module docstring);
-        "sequential": one model after another (no checkpoints or log, for comparisons).
+        specs, training resumes from it (in any mode). None: no checkpoints, no log.
+      mode: "vmap" or "unroll": one jitted step for all K models; "sequential": the jitted single-model step
+        once per model at every step (see the module docstring).
       physics: replaces `PushModel.physics` (default `lynch.predict`).
       progress: show a progress bar with the running loss (mean over models).
-      step_callback: called after every step (not "sequential") with the number of completed steps and
+      step_callback: called after every step with the number of completed steps and
         that step's metrics ({name: [K]} device arrays).
 
     Returns:
@@ -399,17 +401,6 @@ def sweep(
     def batch_at(spec, step):
         return gather(examples, batch_indices(spec, step, train_config.batch_size), fields)
 
-    if mode == "sequential":
-        states, final = [], []
-        for k, spec in enumerate(specs):
-            state = create_train_state(model, optimizer, example_batch, spec.seed)
-            for step in tqdm.trange(train_config.num_steps, desc=spec.name, disable=not progress):
-                state, metrics = step_fn(state, batch_at(spec, step), None if options is None else options[k])
-            states.append(state)
-            final.append(metrics)
-        final_metrics = {name: np.stack([np.asarray(m[name]) for m in final]) for name in final[0]}
-        return SweepResult(model, list(specs), _stack(states), final_metrics)
-
     state = _stack([create_train_state(model, optimizer, example_batch, spec.seed) for spec in specs])
     start = 0
     checkpointer = log = None
@@ -434,6 +425,7 @@ def sweep(
                 )
             start, state, _ = checkpointer.restore_latest(state)
         log = _MetricsLog(workdir / "metrics.csv", start)
+    states = _unstack(state, len(specs)) if mode == "sequential" else None
 
     metrics = None
     with tqdm.tqdm(
@@ -441,8 +433,14 @@ def sweep(
     ) as bar:
         for step in range(start, train_config.num_steps):
             batches = [batch_at(spec, step) for spec in specs]
-            batch = {name: np.stack([b[name] for b in batches]) for name in fields}
-            state, metrics = step_fn(state, batch, options)
+            if mode == "sequential":
+                outputs = [step_fn(states[k], batches[k], None if options is None else options[k])
+                           for k in range(len(specs))]
+                states = [model_state for model_state, _ in outputs]
+                metrics = _stack([model_metrics for _, model_metrics in outputs])
+            else:
+                batch = {name: np.stack([b[name] for b in batches]) for name in fields}
+                state, metrics = step_fn(state, batch, options)
             done = step + 1
             bar.update(1)
             if done % train_config.log_every == 0 or done == train_config.num_steps:
@@ -453,10 +451,12 @@ def sweep(
             if checkpointer is not None and (
                 done % train_config.checkpoint_every == 0 or done == train_config.num_steps
             ):
-                checkpointer.save(done, state, {"identity": identity})
+                checkpointer.save(done, _stack(states) if mode == "sequential" else state, {"identity": identity})
             if step_callback is not None:
                 step_callback(done, metrics)
     if checkpointer is not None:
         checkpointer.close()
+    if mode == "sequential":
+        state = _stack(states)
     final_metrics = {} if metrics is None else jax.tree.map(np.asarray, metrics)
     return SweepResult(model, list(specs), state, final_metrics)

@@ -1,3 +1,4 @@
+import flax.linen as nn
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -76,3 +77,20 @@ def test_free_view_unprojection_recovers_the_point_cloud():
     pixels = jnp.array([[[10.5, 20.5], [3.5, 7.5]]])
     points = perception.unproject_with_depth(pixels, recovered_depth, cameras)
     np.testing.assert_allclose(points[0], cloud[0, [20, 7], [10, 3]], atol=1e-5)
+
+
+@pytest.mark.parametrize("kernel_size", [2, 3, 4, 5])
+@pytest.mark.parametrize("strides", [(1, 1), (2, 2), (3, 2)])
+def test_conv_transpose_matches_flax_in_value_and_gradient(kernel_size, strides):
+    inputs = jax.random.normal(jax.random.key(0), (2, 7, 5, 3))
+    reference = nn.ConvTranspose(4, (kernel_size, kernel_size), strides=strides)
+    ours = perception.ConvTranspose(4, (kernel_size, kernel_size), strides=strides)
+    variables = reference.init(jax.random.key(1), inputs)
+    assert jax.tree.map(jnp.shape, ours.init(jax.random.key(1), inputs)) == jax.tree.map(jnp.shape, variables)
+    np.testing.assert_allclose(ours.apply(variables, inputs), reference.apply(variables, inputs), atol=1e-5)
+
+    def gradients(module):
+        return jax.grad(lambda v, x: jnp.sum(jnp.sin(module.apply(v, x))), argnums=(0, 1))(variables, inputs)
+
+    for ours_leaf, reference_leaf in zip(jax.tree.leaves(gradients(ours)), jax.tree.leaves(gradients(reference))):
+        np.testing.assert_allclose(ours_leaf, reference_leaf, atol=1e-4, rtol=1e-5)

@@ -76,9 +76,11 @@ def test_vmapped_sweep_equals_separate_runs(examples):
     separate = train.sweep(config, examples, specs, mode="sequential", progress=False)
     vmapped = train.sweep(config, examples, specs, mode="vmap", progress=False)
     unrolled = train.sweep(config, examples, specs, mode="unroll", progress=False)
+    # Adam turns float-rounding differences of near-zero gradients into differences of up to a step
+    # (learning rate 1e-3), hence the absolute tolerance of a tenth of one step.
     for together in (vmapped, unrolled):
         jax.tree.map(
-            lambda a, b: np.testing.assert_allclose(a, b, rtol=1e-3, atol=1e-5), _params(together),
+            lambda a, b: np.testing.assert_allclose(a, b, rtol=1e-3, atol=1e-4), _params(together),
             _params(separate),
         )
     # The models differ, so the comparison is not trivially true.
@@ -90,20 +92,22 @@ class Killed(Exception):
     pass
 
 
-def test_killed_training_resumes_to_the_uninterrupted_parameters(examples, tmp_path):
+@pytest.mark.parametrize("mode", ["vmap", "sequential"])
+def test_killed_training_resumes_to_the_uninterrupted_parameters(mode, examples, tmp_path):
     config = _config("hybrid", num_steps=30, checkpoint_every=10, log_every=5)
     specs = train.subset_specs(256, [30, 100], [4])
-    uninterrupted = train.sweep(config, examples, specs, tmp_path / "full", progress=False)
+    uninterrupted = train.sweep(config, examples, specs, tmp_path / "full", mode=mode, progress=False)
 
     def kill_at_step_23(step, metrics):
         if step == 23:
             raise Killed
 
     with pytest.raises(Killed):
-        train.sweep(config, examples, specs, tmp_path / "killed", progress=False, step_callback=kill_at_step_23)
+        train.sweep(config, examples, specs, tmp_path / "killed", mode=mode, progress=False,
+                    step_callback=kill_at_step_23)
     resumed_steps = []
     resumed = train.sweep(
-        config, examples, specs, tmp_path / "killed", progress=False,
+        config, examples, specs, tmp_path / "killed", mode=mode, progress=False,
         step_callback=lambda step, metrics: resumed_steps.append(step),
     )
     assert resumed_steps[0] == 21  # restarted after the checkpoint at step 20

@@ -1,0 +1,91 @@
+"""The paper's findings checked on hand-made results, and the findings binary on smoke runs."""
+
+import json
+
+import pytest
+from absl import app
+
+from pushjax.experiments import findings
+from tests.experiments.conftest import run_binary
+
+
+def _row(model, score, se=0.5, *, size=None, test_split="test", train_split="train", l_scale=1.0):
+    return {"model": model, "kind": "baseline" if size is None else "trained", "train_split": train_split,
+            "test_split": test_split, "train_size": size, "seed": None if size is None else 0, "l_scale": l_scale,
+            "trans_percent": score, "trans_percent_se": se, "rot_percent": score, "rot_percent_se": se}
+
+
+def _results(name, rows, test_splits=("test",)):
+    return {"name": name, "config": {"test_splits": list(test_splits)}, "rows": rows}
+
+
+def _data_efficiency(small, large):
+    rows = [_row(model, value, size=2500) for model, value in small.items()]
+    rows += [_row(model, value, size=20000) for model, value in large.items()]
+    return {"data_efficiency": _results("data_efficiency", rows)}
+
+
+def _verdicts(results):
+    return {finding.key: finding.holds for finding in findings.check(results)}
+
+
+def test_score_is_the_mean_of_translation_and_rotation_with_combined_error():
+    value = findings.score({"trans_percent": 10.0, "trans_percent_se": 3.0, "rot_percent": 20.0,
+                            "rot_percent_se": 4.0})
+    assert (value.value, value.se) == (15.0, 2.5)
+    assert findings.score({"trans_percent": None, "rot_percent": 1.0}) is None
+
+
+def test_data_efficiency_findings():
+    small = {"hybrid": 20.0, "error": 21.0, "neural": 40.0, "simple": 35.0}
+    large = {"neural": 10.0, "hybrid": 12.0, "simple": 15.0, "error": 11.0, "neural_dyn": 5.0}
+    verdicts = _verdicts(_data_efficiency(small, large))
+    assert verdicts["small_data"] is True and verdicts["most_data"] is True
+    # Within two standard errors is not "clearly"; neural_dyn does not count as a perception variant.
+    verdicts = _verdicts(_data_efficiency({**small, "simple": 22.0}, {**large, "error": 9.0}))
+    assert verdicts["small_data"] is False and verdicts["most_data"] is False
+    assert _verdicts(_data_efficiency({"hybrid": 1.0}, {"hybrid": 1.0}))["small_data"] is None
+
+
+def test_velocity_findings():
+    tests = ("test_20", "test_50", "test_100", "test_300")
+    rows = []
+    for split, speed in zip(tests, (20, 50, 100, 300)):
+        rows.append(_row("physics", 30.0, test_split=split))
+        rows.append(_row("hybrid", 32.0, size=1000, test_split=split, train_split="train_20"))
+        rows.append(_row("neural", 20.0 + speed / 5, size=1000, test_split=split, train_split="train_20"))
+        rows.append(_row("neural", 20.0 + speed / 10, size=1000, test_split=split, train_split="train_20_50"))
+    verdicts = _verdicts({"velocities": _results("velocities", rows, tests)})
+    assert verdicts["extrapolation"] is True and verdicts["faster_training"] is True
+    flat = [dict(row, trans_percent=20.0, rot_percent=20.0) if row["model"] == "neural" else row for row in rows]
+    verdicts = _verdicts({"velocities": _results("velocities", flat, tests)})
+    assert verdicts["extrapolation"] is False and verdicts["faster_training"] is False
+
+
+def test_wrong_l_and_new_pushes_findings():
+    rows = [_row(model, value, size=2500, l_scale=scale)
+            for scale, values in ((1.0, {"hybrid": 10.0, "error": 10.0}), (3.0, {"hybrid": 30.0, "error": 15.0}))
+            for model, value in values.items()]
+    pushes = [_row("neural", 30.0, size=2500), _row("hybrid", 20.0, size=2500), _row("error", 25.0, size=2500)]
+    verdicts = _verdicts({"error_variants": _results("error_variants", rows),
+                          "new_pushes": _results("new_pushes", pushes)})
+    assert verdicts["wrong_l"] is True and verdicts["new_pushes"] is True
+    assert verdicts["small_data"] is None
+
+
+def test_findings_binary_on_smoke_results(smoke_results, tmp_path, capsys):
+    output = tmp_path / "findings.md"
+    workdirs = [smoke_results("data_efficiency"), smoke_results("error_variants")]
+    run_binary("findings", f"--workdirs={','.join(map(str, workdirs))}", f"--output={output}")
+    table = output.read_text()
+    assert capsys.readouterr().out.strip().endswith(table.strip())
+    assert table.count("\n| ") == len(findings.CHECKS)
+    assert "| With a wrong l, error compensates better than hybrid. | error_variants |" in table
+
+
+def test_findings_binary_rejects_missing_and_foreign_files(tmp_path):
+    with pytest.raises(app.UsageError, match="results.json does not exist"):
+        run_binary("findings", f"--workdirs={tmp_path}")
+    (tmp_path / "results.json").write_text(json.dumps([1, 2]))
+    with pytest.raises(app.UsageError, match="is not a results.json"):
+        run_binary("findings", f"--workdirs={tmp_path}")
