@@ -3,7 +3,8 @@
 Every finding compares models by their *score*: the mean of the translation and rotation errors in % of
 the ``zero`` baseline (trained models averaged over seeds, `tables.aggregate`), with the standard error
 ``sqrt(se_trans^2 + se_rot^2) / 2``. "Clearly better" means lower by more than twice the standard error
-of the difference. A finding whose experiment or models are missing is reported as not checked.
+of the difference; "improves" means no model clearly worse and at least one clearly better. A finding
+whose experiment or models are missing is reported as not checked.
 """
 
 from __future__ import annotations
@@ -161,7 +162,8 @@ def _faster_training(results: Results) -> tuple[bool | None, str]:
     models = sorted(set(only_20) & set(with_50))
     if not models:
         return None, "needs models trained on train_20 and train_20_50"
-    holds = all(with_50[model].value < only_20[model].value for model in models)
+    holds = (not any(only_20[model].clearly_below(with_50[model]) for model in models)
+             and any(with_50[model].clearly_below(only_20[model]) for model in models))
     return holds, f"mean over {', '.join(faster)}: " + "; ".join(
         f"{model} {only_20[model]} (20) -> {with_50[model]} (20 + 50)" for model in models)
 

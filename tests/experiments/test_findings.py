@@ -60,6 +60,9 @@ def test_velocity_findings():
     flat = [dict(row, trans_percent=20.0, rot_percent=20.0) if row["model"] == "neural" else row for row in rows]
     verdicts = _verdicts({"velocities": _results("velocities", flat, tests)})
     assert verdicts["extrapolation"] is False and verdicts["faster_training"] is False
+    # A model clearly worse with the faster training set breaks "improves" even when another gains.
+    worse = rows + [_row("hybrid", 40.0, size=1000, test_split=split, train_split="train_20_50") for split in tests]
+    assert _verdicts({"velocities": _results("velocities", worse, tests)})["faster_training"] is False
 
 
 def test_wrong_l_and_new_pushes_findings():
