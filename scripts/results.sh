@@ -1,7 +1,7 @@
 #!/bin/bash
 # The runs behind RESULTS.md: every experiment binary at cpu scale, then the findings table.
 #
-#   bash scripts/results.sh [RUNS_DIR]      (default: work/results; about 2.5 h on 2 CPU cores)
+#   bash scripts/results.sh [RUNS_DIR]      (default: work/results; about 2 h on 2 CPU cores)
 #
 # error_variants at l = 1 trains exactly data_efficiency's hybrid and error-variant sweeps (same
 # specs, seeds and subsets), so their finished checkpoints are copied over and only the l = 1.5 and
