@@ -425,22 +425,25 @@ def sweep(
                 )
             start, state, _ = checkpointer.restore_latest(state)
         log = _MetricsLog(workdir / "metrics.csv", start)
-    states = _unstack(state, len(specs)) if mode == "sequential" else None
+    if mode == "sequential":
+        def advance(models, batches):
+            outputs = [step_fn(models[k], batches[k], None if options is None else options[k])
+                       for k in range(len(specs))]
+            return [model_state for model_state, _ in outputs], _stack([metrics for _, metrics in outputs])
+
+        models, stacked = _unstack(state, len(specs)), _stack
+    else:
+        def advance(models, batches):
+            return step_fn(models, {name: np.stack([b[name] for b in batches]) for name in fields}, options)
+
+        models, stacked = state, lambda stacked_state: stacked_state
 
     metrics = None
     with tqdm.tqdm(
         total=train_config.num_steps, initial=start, disable=not progress, desc=f"{len(specs)} models"
     ) as bar:
         for step in range(start, train_config.num_steps):
-            batches = [batch_at(spec, step) for spec in specs]
-            if mode == "sequential":
-                outputs = [step_fn(states[k], batches[k], None if options is None else options[k])
-                           for k in range(len(specs))]
-                states = [model_state for model_state, _ in outputs]
-                metrics = _stack([model_metrics for _, model_metrics in outputs])
-            else:
-                batch = {name: np.stack([b[name] for b in batches]) for name in fields}
-                state, metrics = step_fn(state, batch, options)
+            models, metrics = advance(models, [batch_at(spec, step) for spec in specs])
             done = step + 1
             bar.update(1)
             if done % train_config.log_every == 0 or done == train_config.num_steps:
@@ -451,12 +454,10 @@ def sweep(
             if checkpointer is not None and (
                 done % train_config.checkpoint_every == 0 or done == train_config.num_steps
             ):
-                checkpointer.save(done, _stack(states) if mode == "sequential" else state, {"identity": identity})
+                checkpointer.save(done, stacked(models), {"identity": identity})
             if step_callback is not None:
                 step_callback(done, metrics)
     if checkpointer is not None:
         checkpointer.close()
-    if mode == "sequential":
-        state = _stack(states)
     final_metrics = {} if metrics is None else jax.tree.map(np.asarray, metrics)
-    return SweepResult(model, list(specs), state, final_metrics)
+    return SweepResult(model, list(specs), stacked(models), final_metrics)
