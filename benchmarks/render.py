@@ -1,4 +1,4 @@
-"""Depth rendering throughput of pushjax.render.DepthRenderer on one CPU core.
+"""Depth rendering throughput of pushjax.render.renderer.DepthRenderer on one CPU core.
 
 Each frame sets a new random object pose and pusher position (as dataset generation does), updates the
 kinematics and renders a depth image through EGL. Prints a markdown table.
@@ -20,7 +20,8 @@ os.environ.setdefault("LP_NUM_THREADS", "1")
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
-from pushjax.render import DepthRenderer, free_camera, top_down_camera  # noqa: E402
+from pushjax.render.camera import free_camera, top_down_camera  # noqa: E402
+from pushjax.render.renderer import DepthRenderer  # noqa: E402
 
 # The scene of the naming convention in pushjax.render.renderer with the MIT push dataset's rect1 object.
 SCENE_XML = """

@@ -20,13 +20,14 @@ import jax
 import numpy as np
 from absl import app, flags
 
+from pushjax import train
 from pushjax.data import testing
 from pushjax.models import VARIANTS
-from pushjax.train import train
-from pushjax.train.configs import SCALES, get_config
+from pushjax.data import configs as data_configs
+from pushjax.train.configs import get_config
 
 _VARIANT = flags.DEFINE_enum("variant", "hybrid", VARIANTS, "Model variant.")
-_SCALE = flags.DEFINE_enum("scale", "smoke", SCALES, "Model and optimiser config scale.")
+_SCALE = flags.DEFINE_enum("scale", "smoke", data_configs.SCALES, "Model and optimiser config scale.")
 _SIZES = flags.DEFINE_list("sizes", ["100", "300"], "Training-set sizes.")
 _SEEDS = flags.DEFINE_list("seeds", ["0", "1"], "Subset seeds per size.")
 _NUM_STEPS = flags.DEFINE_integer("num_steps", 200, "Steps per model.", lower_bound=20)
@@ -63,7 +64,7 @@ def _timed_sweep(config, examples, specs, mode):
 def main(argv):
     del argv
     splits = testing.smoke_dataset(_DATA_DIR.value)
-    config = get_config(_SCALE.value).with_variant(_VARIANT.value)
+    config = get_config(data_configs.get_config("data_efficiency", _SCALE.value)).with_variant(_VARIANT.value)
     config = dataclasses.replace(config, num_steps=_NUM_STEPS.value)
     fields = train.model_fields(config.model)
     examples = train.examples_from_source(splits["train"], fields)

@@ -20,11 +20,11 @@ import jax
 import jax.numpy as jnp
 from absl import app, flags
 
-from pushjax.models import perception
-from pushjax.models.networks import MLP
-from pushjax.train.configs import SCALES, get_config
+from pushjax.data import configs as data_configs
+from pushjax.models import MLP, perception
+from pushjax.train.configs import get_config
 
-_SCALE = flags.DEFINE_enum("scale", "smoke", SCALES, "Model config scale.")
+_SCALE = flags.DEFINE_enum("scale", "smoke", data_configs.SCALES, "Model config scale.")
 _MODELS = flags.DEFINE_integer("models", 4, "K, the number of models.", lower_bound=2)
 _REPEATS = flags.DEFINE_integer("repeats", 30, "Timed calls per measurement.", lower_bound=1)
 _IMAGE_SIZE = flags.DEFINE_integer("image_size", 64, "Image side [pixels].")
@@ -93,8 +93,8 @@ def _first_conv_rows(images, features):
 
 def main(argv):
     del argv
-    model = get_config(_SCALE.value).model
-    batch = get_config(_SCALE.value).batch_size
+    config = get_config(data_configs.get_config("data_efficiency", _SCALE.value))
+    model, batch = config.model, config.batch_size
     count, size = _MODELS.value, _IMAGE_SIZE.value
     images = jax.random.normal(jax.random.key(2), (count, batch, size, size, 1))
     glimpses = jax.random.normal(jax.random.key(3), (count, batch, model.glimpse_size, model.glimpse_size, 1))

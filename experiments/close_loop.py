@@ -11,9 +11,11 @@ Writes ``OUT/report.json``, ``OUT/details.json``, ``OUT/report.md`` and ``OUT/fi
 
 import dataclasses
 import json
+import math
 
 from absl import app, flags
 
+import experiments
 from pushjax.loop import LoopSettings, close_loop
 from pushjax.loop.fit import FitSettings
 
@@ -27,15 +29,20 @@ _MIN_GAIN = flags.DEFINE_float("min_gain", LoopSettings.min_gain,
 _MIN_STRENGTH = flags.DEFINE_float("min_strength", LoopSettings.min_strength,
                                    "Share of the error a variable's correction must remove to count as structure.")
 _STEPS = flags.DEFINE_integer("steps", FitSettings.steps, "Adam steps per effect fit.", lower_bound=1)
+experiments.require_writable_folder("workdir")
 
 
 def main(argv):
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
-    if _HORIZON.value <= 0:
+    if not 0 < _HORIZON.value < math.inf:
         raise app.UsageError(f"--horizon: expected a positive duration in s, got {_HORIZON.value}")
     if not 0 < _HELDOUT.value < 1:
         raise app.UsageError(f"--heldout_fraction: expected a fraction in (0, 1), got {_HELDOUT.value}")
+    if not 0 <= _MIN_GAIN.value < 1:
+        raise app.UsageError(f"--min_gain: expected a relative error cut in [0, 1), got {_MIN_GAIN.value}")
+    if not 0 <= _MIN_STRENGTH.value <= 1:
+        raise app.UsageError(f"--min_strength: expected a share of the error in [0, 1], got {_MIN_STRENGTH.value}")
     settings = LoopSettings(horizon=_HORIZON.value, heldout_fraction=_HELDOUT.value, min_gain=_MIN_GAIN.value,
                             min_strength=_MIN_STRENGTH.value,
                             fit=dataclasses.replace(FitSettings(), steps=_STEPS.value))
@@ -48,8 +55,8 @@ def main(argv):
         raise app.UsageError(message) from None
     summary = {key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "explained", "fallback")}
     print(json.dumps(summary, indent=2))
-    print(f"report: {_WORKDIR.value}/report.md")
+    print(f"wrote report.json, details.json, report.md and figures/ to {_WORKDIR.value}")
 
 
 if __name__ == "__main__":
-    app.run(main)
+    experiments.run(main)

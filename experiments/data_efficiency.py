@@ -7,9 +7,10 @@ Sizes larger than the training split are clipped with a warning.
 Writes results.json, results.md and PNG figures to the work directory (all flags: --help).
 """
 
-from absl import app, flags
+from absl import flags
 
-from pushjax.experiments import cli
+import experiments
+from pushjax.paper import cli
 
 flags.adopt_module_key_flags(cli)
 
@@ -19,4 +20,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    app.run(main)
+    experiments.run(main)

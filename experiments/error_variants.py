@@ -6,9 +6,10 @@ error with the limit-surface ratio l set to 1.5 and 3 times its true value).
 Writes results.json, results.md and PNG figures to the work directory (all flags: --help).
 """
 
-from absl import app, flags
+from absl import flags
 
-from pushjax.experiments import cli
+import experiments
+from pushjax.paper import cli
 
 flags.adopt_module_key_flags(cli)
 
@@ -18,4 +19,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    app.run(main)
+    experiments.run(main)

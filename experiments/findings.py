@@ -6,27 +6,48 @@ Each DIR is the --workdir of a finished run of data_efficiency, new_pushes, velo
 prints (and with --output writes) a markdown table: finding, verdict and the numbers behind it.
 """
 
+from pathlib import Path
+
 from absl import app, flags
 
-from pushjax.experiments import findings
+import experiments
+from pushjax.paper import findings, paths
 
-_WORKDIRS = flags.DEFINE_list("workdirs", None, "Work directories holding results.json files.", required=True)
-_OUTPUT = flags.DEFINE_string("output", None, "Also write the table to this file.")
+_WORKDIRS = flags.DEFINE_list("workdirs", None, "Work directories holding results.json files (required).")
+_OUTPUT = flags.DEFINE_string("output", None, "Also write the table to this file (its folder is created).")
 
 
 def main(argv):
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
+    if not _WORKDIRS.value:
+        raise app.UsageError("--workdirs: expected one or more work directories holding results.json")
+    if _OUTPUT.value is not None:
+        check_output_file(_OUTPUT.value)
     try:
         results = findings.load(_WORKDIRS.value)
     except (FileNotFoundError, ValueError) as error:
-        raise app.UsageError(str(error)) from error
+        raise app.UsageError(f"--{error}") from error
     table = findings.markdown(findings.check(results))
     print(table)
-    if _OUTPUT.value:
-        with open(_OUTPUT.value, "w") as file:
-            file.write(table + "\n")
+    if _OUTPUT.value is None:
+        print("wrote no files: the table above is the whole output (--output also writes it to a file)")
+        return
+    output = Path(_OUTPUT.value)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    output.write_text(table + "\n")
+    print(f"wrote the table to {output}")
+
+
+def check_output_file(output: str) -> None:
+    """Raises ``app.UsageError`` unless the table can be written to `output`."""
+    if Path(output).is_dir() or not Path(output).name:
+        raise app.UsageError(f"--output={output}: expected a file name, got a folder")
+    try:
+        paths.check_writable_folder(Path(output).parent)
+    except ValueError as error:
+        raise app.UsageError(f"--output={output}: {error}") from None
 
 
 if __name__ == "__main__":
-    app.run(main)
+    experiments.run(main)

@@ -5,9 +5,10 @@ r"""Table 3: the variants on pushes at angles and contact points never seen in t
 Writes results.json, results.md and PNG figures to the work directory (all flags: --help).
 """
 
-from absl import app, flags
+from absl import flags
 
-from pushjax.experiments import cli
+import experiments
+from pushjax.paper import cli
 
 flags.adopt_module_key_flags(cli)
 
@@ -17,4 +18,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    app.run(main)
+    experiments.run(main)

@@ -6,7 +6,11 @@ r"""Record simulated MIT Push Dataset files (MuJoCo, MIT protocol and raw layout
 
 Pushes are drawn from the MIT grid (side, contact point, angle; velocity and acceleration from the flags) and
 written to ``<out_dir>/<surface>/<object>/motion_surface=..._shape=..._a=..._v=..._i=..._s=..._t=...h5``.
-Existing files are skipped, so an interrupted run can be resumed; the same flags give byte-identical files.
+The same flags give byte-identical files. ``<out_dir>/pushjax_manifest.json`` records the flags that fix the files'
+bytes (all but --objects, --surfaces, --pushes and --workers); a later run into the same folder with other such
+flags, or into a folder of .h5 files without a manifest, is refused. An interrupted run can be resumed: existing
+files that read as valid pushes are kept, invalid (e.g. truncated) ones are recorded again. Runs with the same
+flags may record into one folder at once.
 
 ``--effects`` takes ``name=value`` items separated by ``;`` with vector components separated by ``,``:
 com_offset=dx,dy (m); pressure_rim=k; friction_anisotropy=kx,ky; table_tilt_deg=deg;
@@ -14,10 +18,13 @@ table_tilt_azimuth_deg=deg; pusher_friction=mu; tracking_noise=sigma_xy,sigma_ya
 tracking_bias=dx,dy,dyaw (m, m, rad). See ``pushjax.sim.effects`` for what each one does.
 """
 
+import math
+
 from absl import app, flags
 
+import experiments
 from pushjax.geometry import OBJECT_NAMES
-from pushjax.sim.dataset import record_pushes
+from pushjax.sim.dataset import OutDirConflictError, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
 
@@ -40,8 +47,9 @@ def _numbers(flag: str, values: list[str], low: float, strict: bool) -> list[flo
         numbers = [float(value) for value in values]
     except ValueError:
         raise flags.ValidationError(f"--{flag}: expected comma-separated numbers, got {','.join(values)!r}") from None
-    if not numbers or any((n <= low) if strict else (n < low) for n in numbers):
-        raise flags.ValidationError(f"--{flag}: expected numbers {'>' if strict else '>='} {low:g}, got {numbers}")
+    if not numbers or any(not math.isfinite(n) or ((n <= low) if strict else (n < low)) for n in numbers):
+        raise flags.ValidationError(
+            f"--{flag}: expected finite numbers {'>' if strict else '>='} {low:g}, got {','.join(values)!r}")
     return numbers
 
 
@@ -61,6 +69,7 @@ def _effects(spec: str) -> bool:
     return True
 
 
+experiments.require_writable_folder("out_dir")
 flags.register_validator("objects", lambda v: _names("objects", v, OBJECT_NAMES))
 flags.register_validator("surfaces", lambda v: _names("surfaces", v, SURFACE_NAMES))
 flags.register_validator("velocities", lambda v: _numbers("velocities", v, 0.0, strict=True) is not None)
@@ -71,14 +80,18 @@ flags.register_validator("effects", _effects)
 def main(argv):
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
-    summary = record_pushes(
-        _OUT_DIR.value, _OBJECTS.value, _SURFACES.value, _PUSHES.value, seed=_SEED.value,
-        velocities=_numbers("velocities", _VELOCITIES.value, 0.0, strict=True),
-        accelerations=_numbers("accelerations", _ACCELERATIONS.value, 0.0, strict=False),
-        repeats=_REPEATS.value, effects=Effects.parse(_EFFECTS.value), declare_effects=_DECLARE.value,
-        support=_SUPPORT.value, workers=_WORKERS.value)
-    print(f"wrote {len(summary.written)} files, skipped {len(summary.skipped)} existing files under {_OUT_DIR.value}")
+    try:
+        summary = record_pushes(
+            _OUT_DIR.value, _OBJECTS.value, _SURFACES.value, _PUSHES.value, seed=_SEED.value,
+            velocities=_numbers("velocities", _VELOCITIES.value, 0.0, strict=True),
+            accelerations=_numbers("accelerations", _ACCELERATIONS.value, 0.0, strict=False),
+            repeats=_REPEATS.value, effects=Effects.parse(_EFFECTS.value), declare_effects=_DECLARE.value,
+            support=_SUPPORT.value, workers=_WORKERS.value)
+    except OutDirConflictError as error:
+        raise app.UsageError(f"--{error}") from None
+    print(f"wrote {len(summary.written)} files ({len(summary.rerecorded)} replacing invalid files), "
+          f"reused {len(summary.skipped)} valid existing files under {_OUT_DIR.value}")
 
 
 if __name__ == "__main__":
-    app.run(main)
+    experiments.run(main)

@@ -7,9 +7,10 @@ of each variant (trained on ``data_efficiency``) for one push under many scene t
 Writes fig8_repeated_pushes.png, results.json and results.md to the work directory.
 """
 
-from absl import app, flags
+from absl import flags
 
-from pushjax.experiments import cli
+import experiments
+from pushjax.paper import cli
 
 flags.adopt_module_key_flags(cli)
 
@@ -19,4 +20,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    app.run(main)
+    experiments.run(main)

@@ -26,8 +26,8 @@ run objects --num_steps=2500
 # Train vs test error of neural, neural_dyn and hybrid from data_efficiency (RESULTS.md, "most data"):
 # the finished sweeps are copied and evaluated on their own training split (no training happens).
 for variant in neural neural_dyn hybrid; do
-  rm -rf "$runs/analysis/$variant"; mkdir -p "$runs/analysis"
-  cp -r "$runs/data_efficiency/train/l1/$variant" "$runs/analysis/$variant"
+  rm -rf "$runs/analysis/$variant"; mkdir -p "$runs/analysis/$variant/train/l1"
+  cp -r "$runs/data_efficiency/train/l1/$variant" "$runs/analysis/$variant/train/l1/"
   "$python" -m experiments.train --variant=$variant --experiment=data_efficiency --scale=cpu \
     --workdir="$runs/analysis/$variant" --sizes=2500,190000 --test_split=train
 done

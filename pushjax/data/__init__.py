@@ -1,33 +1,44 @@
-"""Push data: the raw MIT layout (`mit_push`), the example schema, and the TFDS push datasets.
+"""The TFDS push datasets: configurations, the example schema, examples cut from push sequences, the builder.
 
-The dataset API (``PushEffects``, ``build``, ``load``, ``batches``, ``get_config``, ...) is imported on first
-use, so that ``pushjax.sim`` can import ``pushjax.data.mit_push`` without loading TFDS or the builders.
+:mod:`~pushjax.data.configs` defines every dataset (experiment, scale, seed) and its split plan,
+:mod:`~pushjax.data.schema` the fields of an example, :mod:`~pushjax.data.examples` cuts a recorded push sequence
+into examples and :mod:`~pushjax.data.builder` simulates, renders and writes the datasets and reads them back.
+The raw MIT file layout the sequences are cached in lives in :mod:`pushjax.mit`.
 """
 
-import importlib
+from pushjax.data import builder, configs, examples, schema
+from pushjax.data.builder import PushEffects, build, dataset_name, load
+from pushjax.data.configs import (
+    DEFAULT_SCALE,
+    EXPERIMENTS,
+    SCALES,
+    DatasetConfig,
+    SplitPlan,
+    get_config,
+    plan_splits,
+)
+from pushjax.data.examples import ALL_FIELDS, EXTRA_FIELDS, sequence_examples
+from pushjax.data.schema import FIELDS, Field
 
-_LAZY = {
-    "PushEffects": "pushjax.data.builder",
-    "build": "pushjax.data.builder",
-    "load": "pushjax.data.builder",
-    "dataset_name": "pushjax.data.builder",
-    "batches": "pushjax.data.batches",
-    "DatasetConfig": "pushjax.data.configs",
-    "get_config": "pushjax.data.configs",
-    "plan_splits": "pushjax.data.configs",
-    "EXPERIMENTS": "pushjax.data.configs",
-    "SCALES": "pushjax.data.configs",
-    "ALL_FIELDS": "pushjax.data.examples",
-    "EXTRA_FIELDS": "pushjax.data.examples",
-    "sequence_examples": "pushjax.data.examples",
-}
-
-__all__ = sorted(_LAZY)
-
-
-def __getattr__(name):
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'pushjax.data' has no attribute {name!r}")
+__all__ = [
+    "ALL_FIELDS",
+    "DEFAULT_SCALE",
+    "DatasetConfig",
+    "EXPERIMENTS",
+    "EXTRA_FIELDS",
+    "FIELDS",
+    "Field",
+    "PushEffects",
+    "SCALES",
+    "SplitPlan",
+    "build",
+    "builder",
+    "configs",
+    "dataset_name",
+    "examples",
+    "get_config",
+    "load",
+    "plan_splits",
+    "schema",
+    "sequence_examples",
+]

@@ -15,6 +15,10 @@ Resuming: a finished dataset is not rebuilt, and the simulated sequences are cac
 drawn for a smaller scale are a prefix of those of a larger one), so an interrupted build only redoes the
 examples of the dataset it was writing. The same config and seed give the same bytes.
 
+A raw folder given by the user (``raw_dir``, e.g. real MIT files) is read-only to pushjax: it must hold every
+file the config plans, else the build stops with :class:`IncompleteRawDirError` before writing anything; only
+pushjax's own cache is simulated into.
+
 The configuration (image size, glimpse size, horizon, ...) is stored in each dataset's metadata
 (``builder.info.metadata["config"]``) and available as ``builder.builder_config.dataset``.
 """
@@ -37,11 +41,17 @@ from array_record.python.array_record_module import ArrayRecordWriter
 from tensorflow_datasets.core import example_serializer
 
 from pushjax.data import configs
-from pushjax.data.examples import ALL_FIELDS
+from pushjax.data.examples import ALL_FIELDS, make_renderer, sequence_examples
+from pushjax.mit.files import load_push
+from pushjax.sim.dataset import PushJob, record_push
 
 DATASET_NAME = "push_effects"
 RAW_DIR_NAME = "push_effects_raw"
 EXAMPLES_PER_SHARD = 20_000
+
+
+class IncompleteRawDirError(ValueError):
+    """A user's ``raw_dir`` that lacks files the config plans; the message counts them and names the first."""
 
 
 @dataclasses.dataclass(eq=False)
@@ -63,9 +73,10 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
 
     Args:
       seed: dataset seed; a seed other than 0 builds ``<config>_seed<seed>`` next to the seed-0 datasets.
-      raw_dir: root of the raw (MIT layout) cache of simulated sequences; default
-        ``<data_dir>/push_effects_raw/seed<seed>``. A directory of real MIT files laid out the same way works
-        too, as long as it holds every file the config plans.
+      raw_dir: root of a raw (MIT layout) folder to read the sequences from, read-only: building raises
+        :class:`IncompleteRawDirError` (counting the missing files, naming the first) unless it holds every file
+        the config plans, and never writes into it. None (default): pushjax's own cache
+        ``<data_dir>/push_effects_raw/seed<seed>``, where missing sequences are simulated.
       workers: worker processes for simulation and rendering (default: all cores; 1: this process). Workers are
         spawned, so a script that builds with several workers must do so under ``if __name__ == "__main__":``.
       progress: show a progress bar per split.
@@ -96,6 +107,7 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
         super().__init__(**kwargs)
         self._raw_dir = Path(raw_dir) if raw_dir is not None else (
             Path(self.data_dir).parents[2] / RAW_DIR_NAME / f"seed{seed}")
+        self._simulate_missing = raw_dir is None
         self._workers = workers or os.cpu_count() or 1
         self._progress = progress
         self._pool = None
@@ -106,6 +118,7 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
 
     @property
     def raw_dir(self) -> Path:
+        """Where the raw sequences are read from (and, for pushjax's own cache, simulated into)."""
         return self._raw_dir
 
     def _info(self) -> tfds.core.DatasetInfo:
@@ -173,12 +186,19 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
 
     def _split_generators(self, dl_manager):
         plan = configs.plan_splits(self.builder_config.dataset, self._raw_dir)
+        if not self._simulate_missing:
+            missing = [job.path for job in plan.jobs if not job.path.is_file()]
+            if missing:
+                raise IncompleteRawDirError(
+                    f"raw_dir: {len(missing)} of {len(plan.jobs)} files planned for {self.builder_config.name} "
+                    f"are missing under {self._raw_dir} (first: {missing[0]}); a raw folder you give is read-only "
+                    "to pushjax: add the files, or leave raw_dir out to simulate into pushjax's own cache")
         return {name: self._generate_examples(plan, ids, name) for name, ids in plan.splits.items()}
 
     def _generate_examples(self, plan: configs.SplitPlan, ids: tuple[int, ...], split: str) -> Iterator:
         """(key, example) of the split's sequences, in sequence order."""
         dataset = self.builder_config.dataset
-        tasks = [(dataset, plan.jobs[sequence_id], sequence_id) for sequence_id in ids]
+        tasks = [(dataset, plan.jobs[sequence_id], sequence_id, self._simulate_missing) for sequence_id in ids]
         if self._pool is None:
             results = map(sequence_task, tasks)
         else:
@@ -226,23 +246,25 @@ def _close_renderers() -> None:
         _RENDERERS.popitem()[1].close()
 
 
-def sequence_rng(dataset: configs.DatasetConfig, job) -> np.random.Generator:
+def sequence_rng(dataset: configs.DatasetConfig, job: PushJob) -> np.random.Generator:
     """The generator of a sequence's windows, transforms and pusher moves (independent of split and worker)."""
     return np.random.default_rng([dataset.seed, zlib.crc32(job.path.name.encode("utf-8"))])
 
 
-def sequence_task(task) -> dict[str, np.ndarray]:
-    """Worker: records the sequence if it is not cached yet, then returns its stacked examples.
+def sequence_task(task: tuple[configs.DatasetConfig, PushJob, int, bool]) -> dict[str, np.ndarray]:
+    """Worker: reads the sequence's raw file (recording it first if missing and allowed), returns its examples.
 
     Args:
-      task: (DatasetConfig, ``pushjax.sim.dataset.PushJob``, sequence id).
-    """
-    from pushjax.data.examples import make_renderer, sequence_examples
-    from pushjax.data.mit_push import load_push
-    from pushjax.sim.dataset import record_push
+      task: (dataset config, recording job, sequence id, whether a missing raw file may be simulated, i.e. the
+        raw folder is pushjax's own cache).
 
-    dataset, job, sequence_id = task
+    Raises:
+      IncompleteRawDirError: the raw file is missing from a folder that may not be written.
+    """
+    dataset, job, sequence_id, simulate_missing = task
     if not job.path.exists():
+        if not simulate_missing:
+            raise IncompleteRawDirError(f"raw_dir: {job.path} is missing (a raw folder you give is read-only)")
         record_push(job)
     push = load_push(job.path)
     key = (dataset.camera, dataset.image_size, job.params.shape, job.params.surface)

@@ -59,8 +59,11 @@ from pathlib import Path
 
 import numpy as np
 
-from pushjax.data.mit_push import PushParams
-from pushjax.geometry.objects import OBJECT_NAMES
+from pushjax.geometry.objects import OBJECT_NAMES, get_object
+from pushjax.mit.files import PushParams, push_file_path
+from pushjax.mit.protocol import side_points
+from pushjax.sim.dataset import PushJob, plan_pushes
+from pushjax.sim.effects import Effects
 
 EXPERIMENTS = ("data_efficiency", "new_pushes", "velocities", "objects", "viewpoint", "repeated")
 SCALES = ("smoke", "cpu", "paper")
@@ -212,7 +215,7 @@ class SplitPlan:
       splits: split name -> sorted sequence ids.
     """
 
-    jobs: tuple
+    jobs: tuple[PushJob, ...]
     splits: dict[str, tuple[int, ...]]
 
 
@@ -220,10 +223,8 @@ def _key(*parts) -> list[int]:
     return [zlib.crc32(str(part).encode("utf-8")) for part in parts]
 
 
-def _pool(obj: str, velocity: float, pushes: int, config: DatasetConfig, raw_dir: Path) -> list:
+def _pool(obj: str, velocity: float, pushes: int, config: DatasetConfig, raw_dir: Path) -> list[PushJob]:
     """The recording jobs of ``pushes`` draws of ``obj`` at ``velocity`` on every configured surface."""
-    from pushjax.sim.dataset import plan_pushes  # MuJoCo: only needed when planning.
-
     return plan_pushes(raw_dir, [obj], list(config.surfaces), pushes, seed=config.seed, velocities=(velocity,))
 
 
@@ -238,9 +239,6 @@ def _split_off(items: list, fraction: float, rng: np.random.Generator) -> tuple[
 
 def held_out_contact_points(obj: str, config: DatasetConfig) -> frozenset[int]:
     """Contact point ids (see :func:`contact_point_id`) of ``obj`` held out for the ``new_pushes`` test."""
-    from pushjax.sim.push import side_points
-    from pushjax.geometry.objects import get_object
-
     count = len(get_object(obj).sides) * len(side_points(obj))
     rng = np.random.default_rng(_key(config.seed, obj, "held-out points"))
     return frozenset(int(i) for i in rng.permutation(count)[:max(1, round(count * config.held_out_point_fraction))])
@@ -248,8 +246,6 @@ def held_out_contact_points(obj: str, config: DatasetConfig) -> frozenset[int]:
 
 def contact_point_id(params: PushParams) -> int:
     """``side * points_per_side + index of the point`` on the MIT grid of ``params.shape``."""
-    from pushjax.sim.push import side_points
-
     points = side_points(params.shape)
     return params.side * len(points) + int(np.argmin(np.abs(points - params.point)))
 
@@ -262,7 +258,7 @@ def plan_splits(config: DatasetConfig, raw_dir: str | Path) -> SplitPlan:
       raw_dir: root of the raw (MIT layout) cache of the simulated sequences.
     """
     raw_dir = Path(raw_dir)
-    per_split: dict[str, list] = {}  # split name -> recording jobs
+    per_split: dict[str, list[PushJob]] = {}  # split name -> recording jobs
     experiment = config.experiment
     if experiment in ("data_efficiency", "viewpoint", "new_pushes"):
         per_split = {"train": [], "test": []} if experiment != "new_pushes" else {
@@ -323,9 +319,6 @@ def plan_splits(config: DatasetConfig, raw_dir: str | Path) -> SplitPlan:
             per_split[name] = _equal_shares([train_pools[obj] for obj in objects], size)
         per_split = {name: per_split[name] for name in (*OBJECT_TRAIN_SETS, *OBJECT_TEST_SETS)}
     elif experiment == "repeated":
-        from pushjax.sim.dataset import PushJob
-        from pushjax.sim.effects import Effects
-
         per_split = {"test": [PushJob(path=raw_path(raw_dir, REPEATED_PUSH), params=REPEATED_PUSH,
                                       effects=Effects(), support="grid", noise_seed=(config.seed,),
                                       attributes=None)]}
@@ -348,6 +341,4 @@ def _equal_shares(pools: Sequence[list], size: int) -> list:
 
 def raw_path(raw_dir: str | Path, params: PushParams) -> Path:
     """Where the raw (MIT layout) file of a sequence is cached."""
-    from pushjax.data.mit_push import push_file_path
-
     return push_file_path(raw_dir, params)

@@ -1,6 +1,6 @@
 """Push sequences -> examples: the data points of the paper (Sec. III-B), with the fields of `pushjax.data.schema`.
 
-From one recorded push sequence (a cleaned MIT-layout file, :class:`pushjax.data.mit_push.Push`):
+From one recorded push sequence (a cleaned MIT-layout file, :class:`pushjax.mit.files.Push`):
 
 1. Windows: ``windows_per_sequence`` start times drawn uniformly from the samples at which the pusher still
    moves for at least a quarter of the horizon, so windows that begin late hold shorter pushes (the pusher
@@ -39,12 +39,16 @@ import math
 import jax
 import numpy as np
 
+from pushjax import planar
 from pushjax.data.configs import DatasetConfig, contact_point_id
-from pushjax.data.mit_push import Push
 from pushjax.data.schema import FIELDS, Field
 from pushjax.geometry import OBJECT_NAMES, PUSHER_RADIUS, THICKNESS, annotate, get_object, limit_surface_ratio
+from pushjax.mit.files import Push
 from pushjax.physics import lynch
-from pushjax.render import Camera, DepthRenderer, free_camera, point_cloud_from_depth, top_down_camera
+from pushjax.render.camera import Camera, free_camera, point_cloud_from_depth, top_down_camera
+from pushjax.render.renderer import DepthRenderer
+from pushjax.sim import scene
+from pushjax.sim.surfaces import SURFACE_NAMES
 
 EXTRA_FIELDS: dict[str, Field] = {
     "object_pose": Field((3,), np.float32,
@@ -81,8 +85,6 @@ def make_camera(config: DatasetConfig) -> Camera:
 
 def make_renderer(config: DatasetConfig, obj: str, surface: str) -> DepthRenderer:
     """A depth renderer of the testbed scene of ``obj`` on ``surface`` seen by the dataset's camera."""
-    from pushjax.sim import scene  # MuJoCo scene construction; only the builders need it.
-
     model = scene.build_model(obj, surface)
     # Offscreen buffers of the image size, not the scene's 640 x 480 (one GL context per object and worker).
     model.vis.global_.offwidth = model.vis.global_.offheight = config.image_size
@@ -100,22 +102,15 @@ def _outline_radius(obj: str) -> float:
     return float(np.max(np.linalg.norm(shape.outline - shape.centroid, axis=1)))
 
 
-def _rotate(vectors: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """[E, 2] vectors turned by [E] angles (rad)."""
-    cos, sin = np.cos(angle), np.sin(angle)
-    return np.stack([cos * vectors[:, 0] - sin * vectors[:, 1], sin * vectors[:, 0] + cos * vectors[:, 1]], axis=-1)
-
-
 def _com(obj: str, poses: np.ndarray) -> np.ndarray:
     """[E, 2] world centre of mass of [E, 3] tracked-frame poses."""
-    centroid = np.broadcast_to(get_object(obj).centroid, (len(poses), 2))
-    return poses[:, :2] + _rotate(centroid, poses[:, 2])
+    return planar.centre_of_mass(get_object(obj).centroid, poses)
 
 
 def _pixels(points_xy: np.ndarray, camera: Camera) -> np.ndarray:
     """[..., 2] pixel coordinates of table-plane points [..., 2] lifted to the top-face height.
 
-    NumPy twin of :func:`pushjax.render.project` (whose eager JAX calls would compile once per batch shape).
+    NumPy twin of :func:`pushjax.render.camera.project` (whose eager JAX calls would compile once per batch shape).
     """
     points = np.concatenate([points_xy, np.full(points_xy.shape[:-1] + (1,), THICKNESS)], axis=-1)
     world_from_camera = np.asarray(camera.world_from_camera, np.float64)
@@ -193,14 +188,14 @@ def _scene_transforms(com: np.ndarray, pusher_path: np.ndarray, config: DatasetC
     low, high = _VIEW_MARGIN * camera.width, (1 - _VIEW_MARGIN) * camera.width
     for _ in range(_TRANSFORM_ROUNDS):
         target[todo] = rng.uniform(-config.max_translation, config.max_translation, (len(todo), 2))
-        translation = target[todo] - _rotate(com[todo], rotation[todo])
-        ends = np.stack([_rotate(pusher_path[todo, k], rotation[todo]) + translation for k in range(2)], axis=1)
+        translation = target[todo] - planar.rotate(com[todo], rotation[todo])
+        ends = np.stack([planar.rotate(pusher_path[todo, k], rotation[todo]) + translation for k in range(2)], axis=1)
         pixels = _pixels(ends, camera)
         todo = todo[~np.all((pixels >= low) & (pixels <= high), axis=(1, 2))]
         if len(todo) == 0:
             break
     target[todo] = 0.0
-    return rotation, target - _rotate(com, rotation)
+    return rotation, target - planar.rotate(com, rotation)
 
 
 def _choose_windows(push: Push, obj: str, horizon_samples: int, config: DatasetConfig,
@@ -258,12 +253,12 @@ def sequence_examples(push: Push, config: DatasetConfig, renderer: DepthRenderer
                                               config, camera, rng)
 
     def moved_scene(poses):
-        return np.concatenate([_rotate(poses[:, :2], rotation) + translation, (poses[:, 2] + rotation)[:, None]],
+        return np.concatenate([planar.rotate(poses[:, :2], rotation) + translation, (poses[:, 2] + rotation)[:, None]],
                               axis=1)
 
     pose0, pose1 = moved_scene(pose0), moved_scene(pose1)
-    pusher = _rotate(pusher, rotation) + translation
-    action = _rotate(action, rotation)
+    pusher = planar.rotate(pusher, rotation) + translation
+    action = planar.rotate(action, rotation)
 
     # Windows in which the pusher naturally misses the object count towards the no-contact share.
     contact = annotate(obj, pose0, pusher, action)
@@ -283,9 +278,7 @@ def sequence_examples(push: Push, config: DatasetConfig, renderer: DepthRenderer
     if "pushjax_pusher_friction" in push.attributes:
         mu = float(push.attributes["pushjax_pusher_friction"])
     else:
-        from pushjax.sim.scene import pusher_friction
-
-        mu = pusher_friction()
+        mu = scene.pusher_friction()
     push_velocity, _ = lynch.effective_push_velocity(
         contact.contact_rel_com, contact.normal, contact.action_from_contact, l, mu)
 
@@ -340,8 +333,6 @@ def sequence_examples(push: Push, config: DatasetConfig, renderer: DepthRenderer
 
 
 def _surface_id(surface: str) -> int:
-    from pushjax.sim.surfaces import SURFACE_NAMES
-
     if surface not in SURFACE_NAMES:
         raise ValueError(f"push: unknown surface {surface!r}, expected one of {', '.join(SURFACE_NAMES)}")
     return SURFACE_NAMES.index(surface)

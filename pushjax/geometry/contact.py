@@ -40,6 +40,7 @@ import functools
 import numpy as np
 import shapely
 
+from pushjax import planar
 from pushjax.geometry.objects import PUSHER_RADIUS, PushObject, get_object
 
 __all__ = ["NO_CONTACT_FRACTION", "ContactAnnotation", "annotate"]
@@ -129,13 +130,13 @@ def annotate(
     pusher = np.broadcast_to(pusher, batch_shape + (2,)).reshape(-1, 2)
     motion = np.broadcast_to(motion, batch_shape + (2,)).reshape(-1, 2)
 
-    cos, sin = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+    yaw = pose[:, 2]
 
     def to_local(v):
-        return np.stack([cos * v[:, 0] + sin * v[:, 1], -sin * v[:, 0] + cos * v[:, 1]], axis=-1)
+        return planar.rotate(v, -yaw)
 
     def to_world_axes(v):
-        return np.stack([cos * v[:, 0] - sin * v[:, 1], sin * v[:, 0] + cos * v[:, 1]], axis=-1)
+        return planar.rotate(v, yaw)
 
     start_local = to_local(pusher - pose[:, :2])
     motion_local = to_local(motion)

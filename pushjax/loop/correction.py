@@ -21,8 +21,9 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 
-from pushjax.loop.examples import Examples, split_by_sequence
+from pushjax import planar
 from pushjax.loop.fit import PAD_MULTIPLE, zero_scales
+from pushjax.loop.windows import Examples, split_by_sequence
 
 
 class ErrorTerm(nn.Module):
@@ -74,29 +75,22 @@ class ErrorCorrection:
         return _add(examples, prediction, correction, self.scales)
 
 
-def _to_object(vectors: np.ndarray, yaw: np.ndarray) -> np.ndarray:
-    cos, sin = np.cos(yaw), np.sin(yaw)
-    return np.stack([cos * vectors[:, 0] + sin * vectors[:, 1], -sin * vectors[:, 0] + cos * vectors[:, 1]], 1)
-
-
 def _features(examples: Examples, prediction: np.ndarray) -> np.ndarray:
     inputs = examples.inputs
     yaw = np.asarray(inputs.object_yaw, np.float64)
     prediction = np.asarray(prediction, np.float64)
     return np.column_stack([
-        _to_object(np.asarray(inputs.contact), yaw), _to_object(np.asarray(inputs.normal), yaw),
-        _to_object(np.asarray(inputs.action), yaw), _to_object(np.asarray(inputs.pusher_motion), yaw),
+        planar.rotate(np.asarray(inputs.contact), -yaw), planar.rotate(np.asarray(inputs.normal), -yaw),
+        planar.rotate(np.asarray(inputs.action), -yaw), planar.rotate(np.asarray(inputs.pusher_motion), -yaw),
         inputs.gap, inputs.l, inputs.mu, inputs.s, inputs.push_speed, inputs.time_after_stop,
-        _to_object(prediction[:, :2], yaw), prediction[:, 2],
+        planar.rotate(prediction[:, :2], -yaw), prediction[:, 2],
     ])
 
 
 def _add(examples: Examples, prediction: np.ndarray, correction: np.ndarray, scales) -> np.ndarray:
     yaw = np.asarray(examples.inputs.object_yaw, np.float64)
-    cos, sin = np.cos(yaw), np.sin(yaw)
-    dx, dy = scales[0] * correction[:, 0], scales[0] * correction[:, 1]
-    return np.asarray(prediction, np.float64) + np.column_stack(
-        [cos * dx - sin * dy, sin * dx + cos * dy, scales[1] * correction[:, 2]])
+    translation = planar.rotate(scales[0] * correction[:, :2], yaw)
+    return np.asarray(prediction, np.float64) + np.column_stack([translation, scales[1] * correction[:, 2]])
 
 
 def fit_error_correction(
@@ -114,7 +108,7 @@ def fit_error_correction(
     yaw = np.asarray(fit.inputs.object_yaw, np.float64)
     # Residual in the object frame and output units: what the term has to predict.
     residual = np.asarray(fit.target, np.float64) - np.asarray(prediction, np.float64)
-    target = np.column_stack([_to_object(residual[:, :2], yaw) / scales[0], residual[:, 2] / scales[1]])
+    target = np.column_stack([planar.rotate(residual[:, :2], -yaw) / scales[0], residual[:, 2] / scales[1]])
     # Padded like the effect fits (zero weight), so that data sets of similar size share one program.
     size = max(PAD_MULTIPLE, math.ceil(len(fit) / PAD_MULTIPLE) * PAD_MULTIPLE)
     index = np.concatenate([np.arange(len(fit)), np.zeros(size - len(fit), int)])

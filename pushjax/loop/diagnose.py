@@ -21,8 +21,9 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from pushjax import planar
 from pushjax.loop import metrics
-from pushjax.loop.examples import CATEGORICAL, VARIABLES, Examples
+from pushjax.loop.windows import CATEGORICAL, VARIABLES, Examples
 
 MAX_BINS = 8
 SHRINKAGE = 10.0
@@ -37,7 +38,7 @@ class Dependence:
     """How strongly the residual depends on one variable.
 
     Attributes:
-      variable: the variable's name (see :data:`pushjax.loop.examples.VARIABLES`).
+      variable: the variable's name (see :data:`pushjax.loop.windows.VARIABLES`).
       strength: share of the translation + rotation error removed by correcting for the variable
         (see the module docstring).
       lower: the lower bootstrap bound of ``strength``.
@@ -56,11 +57,6 @@ def _frame_angles(examples: Examples) -> dict[str, np.ndarray]:
     motion = np.asarray(examples.inputs.pusher_motion, np.float64)
     return {"world": np.zeros(len(examples)), "push": np.arctan2(motion[:, 1], motion[:, 0]),
             "object": np.asarray(examples.inputs.object_yaw, np.float64)}
-
-
-def _rotate(xy: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    cos, sin = np.cos(angle), np.sin(angle)
-    return np.stack([cos * xy[:, 0] - sin * xy[:, 1], sin * xy[:, 0] + cos * xy[:, 1]], axis=1)
 
 
 def assign_bins(values: np.ndarray, kind: str) -> tuple[np.ndarray, Callable[[np.ndarray], np.ndarray]]:
@@ -123,12 +119,12 @@ def diagnose(
         values = examples.variables[name]
         best = None
         for frame in FRAMES:
-            local = np.column_stack([_rotate(residual[:, :2], -angles[frame]), residual[:, 2]])
+            local = np.column_stack([planar.rotate(residual[:, :2], -angles[frame]), residual[:, 2]])
             shift = np.zeros((len(examples), 3))
             for k in np.unique(fold):
                 train, test = fold != k, fold == k
                 shift[test] = _bin_medians(values[train], local[train], values[test], VARIABLES[name])
-            corrected = prediction + np.column_stack([_rotate(shift[:, :2], angles[frame]), shift[:, 2]])
+            corrected = prediction + np.column_stack([planar.rotate(shift[:, :2], angles[frame]), shift[:, 2]])
             errors = metrics.window_errors(corrected, examples.target, examples.sequence)
             strength = 1 - metrics.combined(metrics.summarize(errors)) / base_score
             if best is None or strength > best[0]:

@@ -28,7 +28,7 @@ import numpy as np
 import optax
 from jax.flatten_util import ravel_pytree
 
-from pushjax.loop.examples import Examples
+from pushjax.loop.windows import Examples
 from pushjax.physics import effects as effects_lib
 from pushjax.physics.effects import EFFECT_NAMES, EFFECTS, PushInputs
 

@@ -9,14 +9,14 @@ from pathlib import Path
 import numpy as np
 import tqdm
 
-from pushjax.data.mit_push import iter_pushes
 from pushjax.loop import correction as correction_lib
 from pushjax.loop import diagnose as diagnose_lib
 from pushjax.loop import fit as fit_lib
 from pushjax.loop import metrics
 from pushjax.loop import report as report_lib
 from pushjax.loop import select as select_lib
-from pushjax.loop.examples import NOMINAL_PUSHER_FRICTION, build_examples, split_by_sequence
+from pushjax.loop.windows import NOMINAL_PUSHER_FRICTION, build_examples, split_by_sequence
+from pushjax.mit.files import iter_pushes
 
 
 @dataclasses.dataclass(frozen=True)

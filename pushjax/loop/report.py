@@ -14,8 +14,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from pushjax.loop import diagnose as diagnose_lib  # noqa: E402
-from pushjax.loop.examples import CATEGORICAL, VARIABLES, Examples  # noqa: E402
 from pushjax.loop.metrics import METRIC_KEYS  # noqa: E402
+from pushjax.loop.windows import CATEGORICAL, VARIABLES, Examples  # noqa: E402
 
 FIGURE_DIR = "figures"
 

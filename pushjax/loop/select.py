@@ -18,7 +18,7 @@ import numpy as np
 
 from pushjax.loop import fit as fit_lib
 from pushjax.loop import metrics
-from pushjax.loop.examples import Examples
+from pushjax.loop.windows import Examples
 from pushjax.physics.effects import EFFECT_NAMES
 
 MIN_GAIN = 0.1

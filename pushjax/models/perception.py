@@ -7,20 +7,29 @@
   world by the image scale at the table (top-down camera) or by a bilinear depth lookup and
   unprojection (free viewpoint).
 
+`Perception` runs both on a batch and returns a `Scene`: the glimpse encoding, the object position and
+the view (`TopDownView` or `FreeView`, looked up in `VIEW_MAPPINGS`), which also maps the contact point
+and normal that the heads predict to the world.
+
 Images are [B, H, W, C] (C = 1 for depth, 3 for point clouds); pixel coordinates (u right, v down,
 pixel centres at +0.5) and cameras follow `pushjax.render.camera`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import ClassVar
 
 import flax.linen as nn
 import jax
 import jax.numpy as jnp
 import numpy as np
+from flax import struct
 
+from pushjax.models.config import IMAGE_FIELDS, ModelConfig
 from pushjax.render import camera as camera_lib
+
+Batch = Mapping[str, jax.Array]
 
 
 def standardise_images(images: jax.Array) -> jax.Array:
@@ -244,3 +253,186 @@ def unproject_with_depth(pixels: jax.Array, depth: jax.Array, cameras: camera_li
         return camera_lib.unproject(pixel, camera_lib.bilinear_lookup(image, pixel), camera)
 
     return jax.vmap(one)(pixels, depth, cameras)
+
+
+@struct.dataclass
+class TopDownView:
+    """The ``top_down`` view: a camera looking straight down at the table, seeing the `depth` image.
+
+    Pixels map to the table by the image scale. The heads predict the contact point as an offset from
+    the pusher in units of `length_scale_m` and the normal in world axes.
+
+    Attributes:
+      cameras: the batch's cameras (array fields with a leading axis B).
+      pusher_pos: [B, 2] pusher position, world xy [m].
+      length_scale_m: unit of the predicted contact offset [m].
+
+    Class attributes:
+      image_field: the batch field of the image.
+      separates_contact_indicator: whether the physics variants predict the motion given contact and
+        the contact indicator s as separate outputs (the free view) or s scales the physics' motion.
+    """
+
+    image_field: ClassVar[str] = IMAGE_FIELDS["top_down"]
+    separates_contact_indicator: ClassVar[bool] = False
+
+    cameras: camera_lib.Camera
+    pusher_pos: jax.Array
+    length_scale_m: float = struct.field(pytree_node=False)
+
+    @classmethod
+    def from_batch(cls, batch: Batch, cameras: camera_lib.Camera, config: ModelConfig) -> TopDownView:
+        """The view of `batch` (reads `pusher_pos`) seen by `cameras`."""
+        return cls(cameras, batch["pusher_pos"], config.length_scale_m)
+
+    def world_points(self, pixels: jax.Array) -> jax.Array:
+        """World xy [B, 2] [m] on the table of pixels [B, 2] (u, v)."""
+        return table_points_top_down(pixels, self.cameras)
+
+    def contact_point(self, raw_contact: jax.Array) -> jax.Array:
+        """World xy [B, 2] [m] of the contact from its predicted [B, 2] offset from the pusher."""
+        return self.pusher_pos + raw_contact * self.length_scale_m
+
+    def contact_and_normal(self, raw_contact: jax.Array, raw_normal: jax.Array) -> tuple[jax.Array, jax.Array]:
+        """World contact xy [B, 2] [m] and normal [B, 2] (world axes, unnormalised) from the predictions.
+
+        Args:
+          raw_contact: [B, 2] offset from the pusher [length_scale_m].
+          raw_normal: [B, 2] normal in world axes.
+        """
+        return self.contact_point(raw_contact), raw_normal
+
+
+@struct.dataclass
+class FreeView:
+    """The ``free`` view: a camera anywhere, seeing the world-frame `point_cloud` image.
+
+    Pixels map to the world by a bilinear lookup in the depth image and unprojection. The heads predict
+    the contact point as a pixel offset from the pusher's pixel in units of half the glimpse side, and
+    the normal in pixels.
+
+    Attributes:
+      cameras: the batch's cameras (array fields with a leading axis B).
+      depth: [B, H, W] depth images [m] of the point clouds.
+      pusher_pixel: [B, 2] pusher (u, v) [pixels].
+      glimpse_size: side of the glimpse around the pusher [pixels].
+
+    Class attributes: as `TopDownView`'s.
+    """
+
+    image_field: ClassVar[str] = IMAGE_FIELDS["free"]
+    separates_contact_indicator: ClassVar[bool] = True
+
+    cameras: camera_lib.Camera
+    depth: jax.Array
+    pusher_pixel: jax.Array
+    glimpse_size: int = struct.field(pytree_node=False)
+
+    @classmethod
+    def from_batch(cls, batch: Batch, cameras: camera_lib.Camera, config: ModelConfig) -> FreeView:
+        """The view of `batch` (reads `point_cloud`, `pusher_pixel`) seen by `cameras`."""
+        depth = depth_from_point_cloud(batch[cls.image_field], cameras)
+        return cls(cameras, depth, batch["pusher_pixel"], config.glimpse_size)
+
+    def world_points(self, pixels: jax.Array) -> jax.Array:
+        """World xy [B, 2] [m] of the surface seen at pixels [B, 2] (u, v)."""
+        return unproject_with_depth(pixels[:, None], self.depth, self.cameras)[:, 0, :2]
+
+    def contact_point(self, raw_contact: jax.Array) -> jax.Array:
+        """World xy [B, 2] [m] of the contact from its predicted [B, 2] offset from the pusher pixel."""
+
+        def to_world(pixel, image, camera):
+            return camera_lib.unproject(pixel, camera_lib.bilinear_lookup(image, pixel), camera)[:2]
+
+        return jax.vmap(to_world)(self._contact_pixel(raw_contact), self.depth, self.cameras)
+
+    def contact_and_normal(self, raw_contact: jax.Array, raw_normal: jax.Array) -> tuple[jax.Array, jax.Array]:
+        """World contact xy [B, 2] [m] and normal [B, 2] (world axes, unnormalised) from the predictions.
+
+        The normal is the world displacement of the contact pixel moved by `raw_normal`, at the
+        contact's depth.
+
+        Args:
+          raw_contact: [B, 2] offset from the pusher pixel [half glimpse sides].
+          raw_normal: [B, 2] normal [pixels].
+        """
+
+        def to_world(pixel, normal_pixel, image, camera):
+            contact_depth = camera_lib.bilinear_lookup(image, pixel)
+            point = camera_lib.unproject(pixel, contact_depth, camera)
+            along_normal = camera_lib.unproject(pixel + normal_pixel, contact_depth, camera)
+            return point[:2], (along_normal - point)[:2]
+
+        return jax.vmap(to_world)(self._contact_pixel(raw_contact), raw_normal, self.depth, self.cameras)
+
+    def _contact_pixel(self, raw_contact: jax.Array) -> jax.Array:
+        return self.pusher_pixel + raw_contact * (self.glimpse_size / 2)
+
+
+View = TopDownView | FreeView
+VIEW_MAPPINGS: dict[str, type[View]] = {"top_down": TopDownView, "free": FreeView}
+"""The view (`config.VIEWS`) -> how its images map to the world."""
+PERCEPTION_OUTPUTS = ("object_pixel", "object_pos")
+"""The `PushModel` outputs that come from the perception."""
+
+
+@struct.dataclass
+class Scene:
+    """What `Perception` sees in a batch.
+
+    Attributes:
+      glimpse: [B, D] encoding of the glimpse around the pusher.
+      object_pixel: [B, 2] predicted object position (u, v) [pixels].
+      object_pos: [B, 2] its world xy [m].
+      view: the batch's view, which maps predicted contacts to the world.
+    """
+
+    glimpse: jax.Array
+    object_pixel: jax.Array
+    object_pos: jax.Array
+    view: View
+
+    def outputs(self) -> dict[str, jax.Array]:
+        """The `PERCEPTION_OUTPUTS` of a `PushModel`."""
+        return {name: getattr(self, name) for name in PERCEPTION_OUTPUTS}
+
+
+class Perception(nn.Module):
+    """The glimpse encoder (submodule ``glimpse``) and object locator (``locator``) on a batch's image.
+
+    Attributes:
+      config: the architecture; `config.view` picks the image and its mapping (`VIEW_MAPPINGS`).
+    """
+
+    config: ModelConfig
+
+    @nn.compact
+    def __call__(self, batch: Batch, train: bool) -> Scene:
+        """Perceives a batch.
+
+        Args:
+          batch: dict with a leading batch axis B; reads `depth` [B, H, W, 1] [m] (top-down view) or
+            `point_cloud` [B, H, W, 3] [m] (free view), `pusher_pixel` [B, 2] [pixels], `pusher_pos`
+            [B, 2] [m], `camera_intrinsics` [B, 4] and `camera_extrinsics` [B, 4, 4].
+          train: normalise the glimpses by the batch's statistics (True) or the running ones (False).
+        """
+        config = self.config
+        view_mapping = VIEW_MAPPINGS[config.view]
+        raw_images = batch[view_mapping.image_field]
+        if raw_images.ndim != 4:
+            raise ValueError(
+                f"batch[{view_mapping.image_field!r}]: expected [B, H, W, C], got {raw_images.shape}"
+            )
+        images = standardise_images(raw_images)
+        height, width = images.shape[1:3]
+        cameras = cameras_from_batch(batch["camera_intrinsics"], batch["camera_extrinsics"], width, height)
+        glimpses = extract_glimpses(images, batch["pusher_pixel"], config.glimpse_size)
+        glimpse = GlimpseEncoder(
+            config.glimpse_features, config.glimpse_kernel, config.batch_norm_momentum, name="glimpse"
+        )(glimpses, train)
+        object_pixel = ObjectLocator(
+            config.locator_conv_features, config.locator_deconv_features, config.locator_kernel,
+            name="locator",
+        )(images)
+        view = view_mapping.from_batch(batch, cameras, config)
+        return Scene(glimpse, object_pixel, view.world_points(object_pixel), view)

@@ -33,7 +33,10 @@ Conventions shared by all functions:
   The remaining ``v_pb . normal <= 0`` guard (``v_p = 0``) only keeps invalid input (``l = 0``)
   finite.
 * Requires ``l > 0`` and ``mu >= 0``. The jitted functions never branch on values; call
-  :func:`check_inputs` on concrete arrays (outside ``jax.jit``) to validate user input.
+  :func:`check_inputs` on concrete arrays (outside ``jax.jit``) to validate user input. They do check
+  shapes and dtypes (real numbers, points with a trailing axis of 2, batch shapes that broadcast) when
+  traced, which is static information: a ``ValueError`` names the argument, under ``jax.jit``,
+  ``jax.vmap`` and ``jax.grad`` alike, at no run-time cost.
 
 All branches are ``jnp.where`` selections whose unselected sides stay finite (the "double where"
 pattern), so ``jax.grad``/``jax.jacfwd`` are finite everywhere, including ``normal = 0``,
@@ -48,6 +51,36 @@ import jax.numpy as jnp
 import numpy as np
 
 __all__ = ["check_inputs", "effective_push_velocity", "object_velocity", "predict"]
+
+
+_POINTS = ("contact", "normal", "action", "v_p")
+"""The arguments that are 2-vectors in the last axis; all others are one number per push."""
+
+
+def _check_shapes_and_dtypes(arrays: dict) -> None:
+    """Raises ``ValueError`` naming the first of `arrays` (name -> array) that is not real numbers of the right shape.
+
+    Reads only ``.shape`` and ``.dtype``, so it works on tracers (``jax.jit``, ``jax.vmap``, ``jax.grad``) when
+    a function is traced and costs nothing at run time. Points (`_POINTS`) are [..., 2], the other arguments
+    [...], and the batch shapes [...] must broadcast against each other.
+    """
+    batch_shapes = {}
+    for name, value in arrays.items():
+        if not (jnp.issubdtype(value.dtype, jnp.floating) or jnp.issubdtype(value.dtype, jnp.integer)):
+            raise ValueError(f"{name}: expected a real numeric array, got dtype {value.dtype}")
+        if name in _POINTS:
+            if value.ndim == 0 or value.shape[-1] != 2:
+                raise ValueError(f"{name}: expected shape [..., 2], got {value.shape}")
+            batch_shapes[name] = value.shape[:-1]
+        else:
+            batch_shapes[name] = value.shape
+    try:
+        np.broadcast_shapes(*batch_shapes.values())
+    except ValueError:
+        raise ValueError(
+            f"{', '.join(batch_shapes)}: batch shapes do not broadcast: "
+            + ", ".join(f"{name} {shape}" for name, shape in batch_shapes.items())
+        ) from None
 
 
 def _split_xy(vectors: jax.Array, dtype) -> tuple[jax.Array, jax.Array]:
@@ -194,6 +227,7 @@ def effective_push_velocity(
       sticking: [...] bool, True where the pusher pushes and the contact sticks.
     """
     contact, normal, action, l, mu = map(jnp.asarray, (contact, normal, action, l, mu))
+    _check_shapes_and_dtypes({"contact": contact, "normal": normal, "action": action, "l": l, "mu": mu})
     dtype = jnp.result_type(contact, normal, action, l, mu, float)
     cx, cy = _split_xy(contact, dtype)
     nx, ny = _split_xy(normal, dtype)
@@ -227,6 +261,7 @@ def object_velocity(contact: jax.Array, v_p: jax.Array, l: jax.Array) -> jax.Arr
       step)] and rotation [rad (per step)], in the frame of ``contact``.
     """
     contact, v_p, l = map(jnp.asarray, (contact, v_p, l))
+    _check_shapes_and_dtypes({"contact": contact, "v_p": v_p, "l": l})
     dtype = jnp.result_type(contact, v_p, l, float)
     cx, cy = _split_xy(contact, dtype)
     vpx, vpy = _split_xy(v_p, dtype)
@@ -258,6 +293,7 @@ def predict(
       step)].
     """
     contact, normal, action, l, mu, s = map(jnp.asarray, (contact, normal, action, l, mu, s))
+    _check_shapes_and_dtypes({"contact": contact, "normal": normal, "action": action, "l": l, "mu": mu, "s": s})
     dtype = jnp.result_type(contact, normal, action, l, mu, s, float)
     cx, cy = _split_xy(contact, dtype)
     nx, ny = _split_xy(normal, dtype)
@@ -282,29 +318,13 @@ def check_inputs(contact, normal, action, l, mu, s=1.0) -> None:
         ``s`` lies outside [0, 1].
     """
     arrays = {
-        "contact": contact, "normal": normal, "action": action, "l": l, "mu": mu, "s": s,
+        name: np.asarray(value)
+        for name, value in {"contact": contact, "normal": normal, "action": action, "l": l, "mu": mu, "s": s}.items()
     }
-    batch_shapes = {}
+    _check_shapes_and_dtypes(arrays)
     for name, value in arrays.items():
-        value = np.asarray(value)
-        if not (np.issubdtype(value.dtype, np.floating) or np.issubdtype(value.dtype, np.integer)):
-            raise ValueError(f"{name}: expected a real numeric array, got dtype {value.dtype}")
-        if name in ("contact", "normal", "action"):
-            if value.ndim == 0 or value.shape[-1] != 2:
-                raise ValueError(f"{name}: expected shape [..., 2], got {value.shape}")
-            batch_shapes[name] = value.shape[:-1]
-        else:
-            batch_shapes[name] = value.shape
         if not np.all(np.isfinite(value)):
             raise ValueError(f"{name}: expected finite values, got NaN or infinity")
-        arrays[name] = value
-    try:
-        np.broadcast_shapes(*batch_shapes.values())
-    except ValueError:
-        raise ValueError(
-            "contact, normal, action, l, mu, s: batch shapes do not broadcast: "
-            + ", ".join(f"{name} {shape}" for name, shape in batch_shapes.items())
-        ) from None
     if np.any(arrays["l"] <= 0):
         raise ValueError("l: expected limit-surface ratio > 0")
     if np.any(arrays["mu"] < 0):

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pushjax import planar
 from pushjax.geometry import contact as contact_lib
 from pushjax.geometry.objects import PUSHER_RADIUS, PushObject, limit_surface_ratio
 from pushjax.physics import lynch
@@ -58,11 +59,7 @@ def rollout(
 
 def _move_about_com(obj: PushObject, pose: np.ndarray, motion: np.ndarray) -> np.ndarray:
     """Apply a COM translation (dx, dy) and a rotation dtheta about the COM to a tracked-frame pose."""
-    cos, sin = np.cos(pose[2]), np.sin(pose[2])
-    com_offset = np.array([cos * obj.centroid[0] - sin * obj.centroid[1],
-                           sin * obj.centroid[0] + cos * obj.centroid[1]])
-    cos_d, sin_d = np.cos(motion[2]), np.sin(motion[2])
-    rotated_offset = np.array([cos_d * com_offset[0] - sin_d * com_offset[1],
-                               sin_d * com_offset[0] + cos_d * com_offset[1]])
+    com_offset = planar.rotate(obj.centroid, pose[2])
+    rotated_offset = planar.rotate(com_offset, motion[2])
     com = pose[:2] + com_offset + motion[:2]
     return np.array([*(com - rotated_offset), pose[2] + motion[2]])

@@ -1,6 +1,8 @@
-"""Cameras (pure JAX) and offscreen MuJoCo depth / point-cloud rendering of the pushing scene.
+"""Cameras of the pushing scene (pure JAX, :mod:`~pushjax.render.camera`); this package exports only them.
 
-Importing this package sets `MUJOCO_GL=egl` unless the variable is already set (see `renderer`).
+The offscreen MuJoCo depth / point-cloud renderer is imported explicitly, so that camera maths never loads
+MuJoCo: ``from pushjax.render.renderer import DepthRenderer`` (it sets ``MUJOCO_GL=egl`` unless the variable is
+already set).
 """
 
 from pushjax.render.camera import (
@@ -20,21 +22,6 @@ from pushjax.render.camera import (
     unproject_to_camera,
     world_to_camera,
 )
-from pushjax.render.renderer import (
-    CAMERA,
-    OBJECT_BODY,
-    OBJECT_JOINT,
-    PUSHER_BODY,
-    PUSHER_CLEARANCE_M,
-    TABLE_GEOM,
-    DepthRenderer,
-    apply_scene_transform,
-    planar_transform,
-    random_scene_transform,
-    set_camera,
-    transform_planar_points,
-    transform_planar_poses,
-)
 
 __all__ = [
     "Camera",
@@ -52,17 +39,4 @@ __all__ = [
     "unproject",
     "unproject_to_camera",
     "world_to_camera",
-    "CAMERA",
-    "OBJECT_BODY",
-    "OBJECT_JOINT",
-    "PUSHER_BODY",
-    "PUSHER_CLEARANCE_M",
-    "TABLE_GEOM",
-    "DepthRenderer",
-    "apply_scene_transform",
-    "planar_transform",
-    "random_scene_transform",
-    "set_camera",
-    "transform_planar_points",
-    "transform_planar_poses",
 ]

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import copy
 import os
+import weakref
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
@@ -43,7 +44,7 @@ _INTRINSICS_TOLERANCE_PX = 1e-3
 def _object_id(model: mujoco.MjModel, object_type: mujoco.mjtObj, name: str, what: str) -> int:
     object_id = mujoco.mj_name2id(model, object_type, name)
     if object_id < 0:
-        raise ValueError(f"model has no {what} named {name!r} (see the pushjax.render naming convention).")
+        raise ValueError(f"model has no {what} named {name!r} (see the pushjax.render.renderer naming convention).")
     return object_id
 
 
@@ -157,6 +158,10 @@ class DepthRenderer:
                 "could not create an OpenGL context; run headless with MUJOCO_GL=egl set before mujoco is "
                 f"first imported (it is {os.environ.get('MUJOCO_GL')!r} now)"
             ) from error
+        # Frees the OpenGL context when the renderer is collected, and at the latest at interpreter exit
+        # (atexit), while the modules that freeing needs still exist: mujoco.Renderer's own __del__ would run
+        # during module teardown and print a traceback there.
+        self._close = weakref.finalize(self, self._renderer.close)
         self._point_cloud = jax.jit(point_cloud_from_depth, static_argnames="frame")
 
     def set_state(self, object_pose: np.ndarray, pusher_xy: np.ndarray) -> None:
@@ -216,8 +221,8 @@ class DepthRenderer:
         return self._render(object_pose, pusher_xy, depth=False)
 
     def close(self) -> None:
-        """Frees the OpenGL resources; the renderer is unusable afterwards."""
-        self._renderer.close()
+        """Frees the OpenGL resources; the renderer is unusable afterwards. Closing twice does nothing."""
+        self._close()
 
     def __enter__(self) -> DepthRenderer:
         return self

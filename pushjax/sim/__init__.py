@@ -1,7 +1,8 @@
-"""MuJoCo testbed standing in for the MIT Push Dataset: scenes, the MIT push protocol, effects, recording.
+"""MuJoCo testbed standing in for the MIT Push Dataset: scenes, simulated pushes, effects, recording.
 
-``scene`` builds the MJCF scenes, ``push`` simulates and records single pushes, ``dataset`` records whole data
-sets in parallel (``experiments/record_pushes.py``), ``effects`` declares the physical and sensor effects and
+``scene`` builds the MJCF scenes, ``push`` simulates and records single pushes along the MIT protocol of
+:mod:`pushjax.mit.protocol`, ``dataset`` records whole data sets in parallel (``experiments/record_pushes.py``)
+in the file layout of :mod:`pushjax.mit.files`, ``effects`` declares the physical and sensor effects and
 ``surfaces`` the friction data. ``pushjax.sim.quasi_static`` (which imports JAX) compares slow pushes with the
 quasi-static model.
 """
@@ -9,7 +10,7 @@ quasi-static model.
 from pushjax.sim import dataset, effects, push, scene, surfaces
 from pushjax.sim.dataset import plan_pushes, record_pushes
 from pushjax.sim.effects import Effects
-from pushjax.sim.push import Recording, Simulator, sample_push, simulate_push
+from pushjax.sim.push import Recording, Simulator, simulate_push
 from pushjax.sim.scene import build_model, scene_xml, write_scene
 from pushjax.sim.surfaces import SURFACE_NAMES, get_surface
 
@@ -25,7 +26,6 @@ __all__ = [
     "plan_pushes",
     "push",
     "record_pushes",
-    "sample_push",
     "scene",
     "scene_xml",
     "simulate_push",

@@ -5,15 +5,25 @@ Determinism: the pushes of an (object, surface) pair are drawn one after another
 drawn again from the same generator), in the calling process; each push is then simulated from the same
 settled state in whichever worker, with its tracking noise drawn from a generator seeded by
 ``[seed, crc32(object), crc32(surface), i, repetition]``. So the same arguments give byte-identical files for
-any number of workers, and existing files are skipped (the run can be resumed).
+any number of workers.
+
+Resuming: :func:`record_pushes` keeps the settings that determine every file's bytes (seed, velocities,
+accelerations, repeats, effects, declare_effects, support and the MuJoCo version) in ``<out_dir>/``
+:data:`MANIFEST_NAME`, written before the first file. A later call into the same folder must have the same
+settings (it may ask for other objects, surfaces or push counts: under the same settings a file's name fixes its
+bytes), else it is refused with :class:`OutDirConflictError`; a folder that holds ``.h5`` files but no manifest
+(e.g. real MIT files) is refused too. Existing files that read as valid pushes are reused, invalid ones (truncated,
+corrupt) are recorded again and counted. Several calls with the same settings may record into one folder at once.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import multiprocessing
 import os
+import secrets
 import zlib
 from collections.abc import Sequence
 from pathlib import Path
@@ -21,16 +31,26 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import tqdm
+from absl import logging
 
-from pushjax.data.mit_push import PushParams, push_file_name, push_file_path, write_push
 from pushjax.geometry.objects import OBJECT_NAMES, get_object
+from pushjax.mit.files import PushFileError, PushParams, push_file_name, push_file_path, read_raw_push, write_push
+from pushjax.mit.protocol import MIT_ANGLES, MIT_VELOCITIES, sample_push, side_points
 from pushjax.sim import scene
 from pushjax.sim.effects import Effects
-from pushjax.sim.push import MIT_ANGLES, MIT_VELOCITIES, sample_push, side_points, simulate_push
+from pushjax.sim.push import simulate_push
 from pushjax.sim.surfaces import SURFACE_NAMES, get_surface
 
 _MAX_DRAWS_PER_PUSH = 1000
 """Draws after which a push that keeps hitting already drawn file names gives up."""
+
+MANIFEST_NAME = "pushjax_manifest.json"
+"""The file in a :func:`record_pushes` folder that holds the settings its files were recorded with."""
+
+
+class OutDirConflictError(ValueError):
+    """An ``out_dir`` that :func:`record_pushes` must not record into: its manifest holds other settings, the
+    manifest is unreadable, or the folder holds push files but no manifest. The message names the folder."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -56,10 +76,17 @@ class PushJob:
 
 @dataclasses.dataclass(frozen=True)
 class RecordSummary:
-    """What :func:`record_pushes` did: ``written`` new files and ``skipped`` files that already existed."""
+    """What :func:`record_pushes` did.
+
+    Attributes:
+      written: the files recorded by this call, in plan order.
+      skipped: existing files that read as valid pushes and were kept, in plan order.
+      rerecorded: the written files that replaced an existing invalid (truncated, corrupt) file.
+    """
 
     written: list[Path]
     skipped: list[Path]
+    rerecorded: list[Path]
 
 
 def _name_key(name: str) -> int:
@@ -145,8 +172,13 @@ def record_pushes(
 ) -> RecordSummary:
     """Records simulated pushes as MIT raw files under ``out_dir/<surface>/<object>/``.
 
+    Resumable: files that already exist and read as valid pushes (``pushjax.mit.read_raw_push``) are kept, invalid
+    ones are recorded again. ``out_dir/pushjax_manifest.json`` (:data:`MANIFEST_NAME`) records the settings that fix
+    the files' bytes (:func:`recording_settings`); a call whose settings differ from it is refused (see the module
+    docstring).
+
     Args:
-      out_dir: dataset root.
+      out_dir: dataset root; new, empty, or recorded by earlier calls with the same settings.
       objects: object names (``pushjax.geometry.OBJECT_NAMES``).
       surfaces: surface names (``abs``, ``delrin``, ``plywood``, ``pu``).
       pushes: distinct pushes per (object, surface), drawn from the MIT grid.
@@ -163,13 +195,33 @@ def record_pushes(
 
     Returns:
       The :class:`RecordSummary`.
+
+    Raises:
+      OutDirConflictError: ``out_dir``'s manifest holds other settings (the message names each differing
+        setting), or ``out_dir`` holds ``.h5`` files but no manifest; nothing is written then.
+      ValueError: an invalid argument, naming it.
     """
     if workers is not None and (not isinstance(workers, int) or workers < 1):
         raise ValueError(f"workers: expected an integer >= 1, got {workers!r}")
     jobs = plan_pushes(out_dir, objects, surfaces, pushes, seed, velocities, accelerations, repeats, effects,
                        declare_effects, support)
-    skipped = [job.path for job in jobs if job.path.exists()]
-    todo = [job for job in jobs if not job.path.exists()]
+    _claim_out_dir(Path(out_dir), recording_settings(seed, velocities, accelerations, repeats, effects,
+                                                     declare_effects, support))
+    skipped, todo, invalid = [], [], {}
+    for job in jobs:
+        if not job.path.exists():
+            todo.append(job)
+            continue
+        try:
+            read_raw_push(job.path)
+        except PushFileError as error:
+            invalid[job.path] = error
+            todo.append(job)
+        else:
+            skipped.append(job.path)
+    if invalid:
+        logging.warning("recording again %d invalid existing files under %s (first: %s)", len(invalid),
+                        out_dir, next(iter(invalid.values())))
     workers = min(workers or os.cpu_count() or 1, max(1, len(todo)))
     written = []
     with tqdm.tqdm(total=len(todo), disable=not progress, unit="push", desc="recording") as bar:
@@ -184,7 +236,79 @@ def record_pushes(
                 for path in pool.imap(record_push, todo, chunksize=chunk):
                     written.append(path)
                     bar.update()
-    return RecordSummary(written=written, skipped=skipped)
+    return RecordSummary(written=written, skipped=skipped,
+                         rerecorded=[path for path in written if path in invalid])
+
+
+def recording_settings(
+    seed: int,
+    velocities: Sequence[float],
+    accelerations: Sequence[float],
+    repeats: int,
+    effects: Effects,
+    declare_effects: bool,
+    support: str,
+) -> dict:
+    """The settings that fix the bytes of every file :func:`record_pushes` writes, as JSON values.
+
+    Arguments as in :func:`record_pushes` (velocities in mm/s, accelerations in mm/s², both in draw order);
+    ``simulator`` adds the MuJoCo version.
+    """
+    return {
+        "seed": int(seed),
+        "velocities": [float(velocity) for velocity in velocities],
+        "accelerations": [float(acceleration) for acceleration in accelerations],
+        "repeats": int(repeats),
+        "effects": effects.to_dict(),
+        "declare_effects": bool(declare_effects),
+        "support": support,
+        "simulator": f"mujoco {mujoco.__version__}",
+    }
+
+
+def _claim_out_dir(out_dir: Path, settings: dict) -> None:
+    """Writes ``out_dir``'s manifest if it has none, then checks that it holds ``settings``.
+
+    The manifest is published with ``os.link`` from a temporary file of this call's own: it appears complete or
+    not at all, and an existing one is never replaced, so concurrent calls all check against the first one's.
+
+    Raises:
+      OutDirConflictError: see :func:`record_pushes`.
+    """
+    manifest = out_dir / MANIFEST_NAME
+    if not manifest.exists():
+        push_files = sum(1 for _ in out_dir.rglob("*.h5")) if out_dir.is_dir() else 0
+        # A concurrent call publishes its manifest before its first file, so files seen without one are foreign.
+        if push_files and not manifest.exists():
+            raise OutDirConflictError(
+                f"out_dir: {out_dir} holds {push_files} .h5 file(s) but no {MANIFEST_NAME}, so record_pushes did "
+                "not make it; record into a new or empty folder")
+        if not push_files:
+            out_dir.mkdir(parents=True, exist_ok=True)
+            text = json.dumps({"generator": "pushjax.sim.dataset.record_pushes", "settings": settings},
+                              indent=2, sort_keys=True) + "\n"
+            partial = out_dir / f".{MANIFEST_NAME}.{os.getpid()}.{secrets.token_hex(8)}.partial"
+            partial.write_text(text, encoding="utf-8")
+            try:
+                os.link(partial, manifest)
+            except FileExistsError:
+                pass  # a concurrent call published first; its manifest is checked below
+            finally:
+                partial.unlink()
+    try:
+        recorded = json.loads(manifest.read_text(encoding="utf-8"))["settings"]
+        if not isinstance(recorded, dict):
+            raise TypeError(f"settings must be a JSON object, got {type(recorded).__name__}")
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError) as error:
+        raise OutDirConflictError(
+            f"out_dir: {manifest} is not a readable record_pushes manifest ({error!r}); record into a new folder"
+        ) from None
+    differing = [_difference(name, recorded.get(name), value)
+                 for name, value in settings.items() if recorded.get(name) != value]
+    if differing:
+        raise OutDirConflictError(
+            f"out_dir: {out_dir} was recorded with other settings ({MANIFEST_NAME}): {'; '.join(differing)}; "
+            "record into another folder or use the recorded settings")
 
 
 def _check_arguments(objects, surfaces, pushes, seed, velocities, accelerations, repeats, effects, support):
@@ -208,3 +332,13 @@ def _check_arguments(objects, surfaces, pushes, seed, velocities, accelerations,
         raise ValueError(f"effects: expected an Effects, got {type(effects).__name__}")
     if support not in scene.SUPPORT_MODES:
         raise ValueError(f"support: expected one of {', '.join(scene.SUPPORT_MODES)}, got {support!r}")
+
+
+def _difference(name: str, recorded, requested) -> str:
+    """``name recorded there, requested now``; for two dicts (effects) only their differing fields."""
+    if isinstance(recorded, dict) and isinstance(requested, dict):
+        fields = [field for field in sorted(set(recorded) | set(requested))
+                  if recorded.get(field) != requested.get(field)]
+        parts = [_difference(field, recorded.get(field), requested.get(field)) for field in fields]
+        return f"{name} ({', '.join(parts)})"
+    return f"{name} {json.dumps(recorded)} there, {json.dumps(requested)} now"

@@ -1,14 +1,8 @@
 """Simulated pushes following the MIT Push Dataset protocol, recorded in the dataset's raw layout.
 
-Protocol (Yu et al., IROS 2016; the collection script ``collect_push_dataset_with_acceleration.py`` in
-``github.com/mcubelab/push-est-public``): the pusher touches side ``i`` of the object at the fraction ``s`` of
-its length (the pusher centre one pusher radius out along the side's normal) and moves in the direction of the
-side's inward normal turned by the angle ``t`` (counter-clockwise positive), either at constant velocity ``v``
-(``a = 0``) or accelerating from rest at ``a``, until it has travelled 5 cm past the contact point. Here the
-pusher starts 3 mm before that contact point (along the push direction), at velocity ``v`` for constant-velocity
-pushes (the robot reaches it within 0.2 mm at the dataset's 100 m/s²) and at rest for accelerating ones, which
-accelerate up to ``v`` (the MIT robot capped them at 1 m/s). When the pusher stops, recording goes on for 0.5 s
-so that any sliding after the push is recorded.
+The pusher follows the protocol of :mod:`pushjax.mit.protocol` (path :func:`~pushjax.mit.protocol.pusher_line`,
+motion :func:`~pushjax.mit.protocol.pusher_motion`). When the pusher stops, recording goes on for 0.5 s so that
+any sliding after the push is recorded.
 
 Recording (250 Hz, one clock, ``t`` from 0 at the start of the pusher's motion):
 
@@ -38,18 +32,16 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from pushjax.data.mit_push import PushParams
-from pushjax.geometry.objects import PUSHER_RADIUS, PushObject, get_object
+from pushjax import planar
+from pushjax.geometry.objects import PushObject, get_object
+from pushjax.mit.files import PushParams
+from pushjax.mit.protocol import push_duration, pusher_line, pusher_motion
 from pushjax.sim import scene
 from pushjax.sim.effects import Effects
 
 SAMPLE_RATE = 250.0
 """Recording rate in Hz."""
 SAMPLE_PERIOD = 1.0 / SAMPLE_RATE
-PUSH_DISTANCE = 0.05
-"""Pusher travel past the nominal contact point in m."""
-APPROACH_DISTANCE = 0.003
-"""Pusher travel before the nominal contact point in m."""
 POST_PUSH_DURATION = 0.5
 """Recording time after the pusher stops in s."""
 SETTLE_DURATION = 0.3
@@ -58,105 +50,8 @@ MAX_STEP_TRAVEL = 1e-4
 """Largest pusher advance per simulation step in m."""
 MIN_STEPS_PER_SAMPLE = 2
 
-MIT_VELOCITIES = (10.0, 20.0, 50.0, 75.0, 100.0, 150.0, 200.0, 300.0, 400.0, 500.0)
-"""Constant pusher velocities of the MIT grid, mm/s."""
-MIT_ACCELERATIONS = (100.0, 200.0, 500.0, 750.0, 1000.0, 1500.0, 2000.0, 2500.0)
-"""Pusher accelerations of the MIT grid, mm/s² (0 = constant velocity is the other option)."""
-MIT_ANGLES = tuple(np.radians(np.linspace(-80.0, 80.0, 9)))
-"""Push angles of the MIT grid to the side's inward normal, rad (-80° to 80° in 20° steps)."""
-
 _PARKED_PUSHER = np.array([1.0, 1.0])
 """Where the pusher waits while the object settles, m (far from every object)."""
-
-
-def side_points(obj: PushObject | str) -> np.ndarray:
-    """Contact fractions ``s`` of the MIT grid on each side of ``obj``.
-
-    The collection script pushes polygon sides at ``s`` = 0, 0.1, ..., 1 (it meant to use 0, 0.2, ..., 1 for
-    hex, but its test compares the vertex list with the string "hex", so hex gets the 11 points too) and curved
-    outlines at 40 points evenly spaced around the whole outline; with the outline cut into four quarter sides
-    (see :class:`pushjax.geometry.PushObject`) that is ``s`` = 0, 0.1, ..., 0.9 on each quarter.
-    """
-    if isinstance(obj, str):
-        obj = get_object(obj)
-    if any(len(side) > 2 for side in obj.sides):
-        return np.arange(10) / 10
-    return np.linspace(0.0, 1.0, 11)
-
-
-def sample_push(
-    obj: PushObject | str,
-    surface: str,
-    rng: np.random.Generator,
-    velocities: Sequence[float] = MIT_VELOCITIES,
-    accelerations: Sequence[float] = (0.0,),
-) -> PushParams:
-    """A push drawn uniformly from the MIT grid: side, contact point, angle, velocity and acceleration.
-
-    Args:
-      obj: the object or its name.
-      surface: surface name, stored in the returned parameters.
-      rng: the random generator to draw from.
-      velocities: allowed pusher velocities, mm/s (> 0; for accelerating pushes the top speed).
-      accelerations: allowed pusher accelerations, mm/s² (0 = constant velocity).
-
-    Returns:
-      The push, with ``point`` and ``angle`` rounded to the 3 decimals that the file name keeps, so that the
-      simulated push is exactly the one its file name describes.
-    """
-    if isinstance(obj, str):
-        obj = get_object(obj)
-    if not velocities or not accelerations:
-        raise ValueError("velocities and accelerations: expected at least one value each")
-    return PushParams(
-        surface=surface,
-        shape=obj.name,
-        acceleration=float(rng.choice(np.asarray(accelerations, dtype=np.float64))),
-        velocity=float(rng.choice(np.asarray(velocities, dtype=np.float64))),
-        side=int(rng.integers(len(obj.sides))),
-        point=round(float(rng.choice(side_points(obj))), 3),
-        angle=round(float(rng.choice(MIT_ANGLES)), 3),
-    )
-
-
-def pusher_line(obj: PushObject | str, params: PushParams) -> tuple[np.ndarray, np.ndarray]:
-    """Start point [2] (m, object frame) and unit direction [2] of the pusher centre's straight path."""
-    if isinstance(obj, str):
-        obj = get_object(obj)
-    point, inward = obj.side_point(params.side, params.point)
-    cos, sin = math.cos(params.angle), math.sin(params.angle)
-    direction = np.array([cos * inward[0] - sin * inward[1], sin * inward[0] + cos * inward[1]])
-    contact_centre = point - PUSHER_RADIUS * inward
-    return contact_centre - APPROACH_DISTANCE * direction, direction
-
-
-def pusher_motion(params: PushParams, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Distance travelled (m) and speed (m/s) of the pusher at ``times`` [T] (s) since it started."""
-    travel = APPROACH_DISTANCE + PUSH_DISTANCE
-    speed, acceleration = params.velocity_si, params.acceleration_si
-    times = np.asarray(times, dtype=np.float64)
-    if acceleration <= 0:
-        distance = speed * times
-        velocity = np.full_like(times, speed)
-    else:
-        ramp = speed / acceleration
-        distance = np.where(times < ramp, 0.5 * acceleration * times ** 2, 0.5 * acceleration * ramp ** 2
-                            + speed * (times - ramp))
-        velocity = np.minimum(acceleration * times, speed)
-    moving = distance < travel
-    return np.where(moving, distance, travel), np.where(moving, velocity, 0.0)
-
-
-def push_duration(params: PushParams) -> float:
-    """Time in s from the start of the pusher's motion to its stop."""
-    travel = APPROACH_DISTANCE + PUSH_DISTANCE
-    speed, acceleration = params.velocity_si, params.acceleration_si
-    if acceleration <= 0:
-        return travel / speed
-    ramp = speed / acceleration
-    if 0.5 * acceleration * ramp ** 2 >= travel:
-        return math.sqrt(2 * travel / acceleration)
-    return ramp + (travel - 0.5 * acceleration * ramp ** 2) / speed
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -253,7 +148,7 @@ class Simulator:
         samples = math.ceil((push_duration(params) + POST_PUSH_DURATION) / SAMPLE_PERIOD) + 1
         nstep = (samples - 1) * steps_per_sample
 
-        rotation = _rotation(pose[2])
+        rotation = planar.rotation_matrix(pose[2])
         start_local, direction_local = pusher_line(self.obj, params)
         start = pose[:2] + rotation @ start_local
         direction = rotation @ direction_local
@@ -306,8 +201,7 @@ def _tracked(true_pose: np.ndarray, effects: Effects, rng: np.random.Generator |
     dx, dy, dyaw = effects.tracking_bias
     yaw = true_pose[:, 3]
     recorded = true_pose.copy()
-    recorded[:, 1] += np.cos(yaw) * dx - np.sin(yaw) * dy
-    recorded[:, 2] += np.sin(yaw) * dx + np.cos(yaw) * dy
+    recorded[:, 1:3] += planar.rotate(np.array([dx, dy]), yaw)
     recorded[:, 3] += dyaw
     if rng is not None:
         sigma_xy, sigma_yaw = effects.tracking_noise
@@ -316,11 +210,6 @@ def _tracked(true_pose: np.ndarray, effects: Effects, rng: np.random.Generator |
         recorded[:, 3] += sigma_yaw * noise[:, 2]
     recorded[:, 3] = np.angle(np.exp(1j * recorded[:, 3]))
     return recorded
-
-
-def _rotation(yaw: float) -> np.ndarray:
-    cos, sin = math.cos(yaw), math.sin(yaw)
-    return np.array([[cos, -sin], [sin, cos]])
 
 
 def _yaw_quaternion(yaw: float) -> np.ndarray:

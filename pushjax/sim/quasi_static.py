@@ -15,13 +15,15 @@ import dataclasses
 
 import numpy as np
 
-from pushjax.data.mit_push import PushParams
+from pushjax import planar
 from pushjax.geometry.contact import annotate
 from pushjax.geometry.objects import get_object, limit_surface_ratio
+from pushjax.mit.files import PushParams
+from pushjax.mit.protocol import push_duration, sample_push
 from pushjax.physics import lynch
 from pushjax.sim import scene
 from pushjax.sim.effects import Effects
-from pushjax.sim.push import SAMPLE_RATE, push_duration, sample_push, simulator
+from pushjax.sim.push import SAMPLE_RATE, simulator
 
 WINDOW_DURATION = 0.5
 """Length of a prediction window in s."""
@@ -88,7 +90,7 @@ def quasi_static_agreement(obj: str, surface: str = "abs", pushes: int = 30, win
             continue
         prediction = np.asarray(lynch.predict(contact.contact_rel_com, contact.normal, contact.action_from_contact,
                                               l, mu))[..., :2]
-        simulated.append((_com(shape.centroid, pose1) - _com(shape.centroid, pose0))[keep])
+        simulated.append((planar.centre_of_mass(shape.centroid, pose1) - planar.centre_of_mass(shape.centroid, pose0))[keep])
         predicted.append(prediction[keep])
     simulated = np.concatenate(simulated)
     predicted = np.concatenate(predicted)
@@ -99,8 +101,3 @@ def quasi_static_agreement(obj: str, surface: str = "abs", pushes: int = 30, win
         median_motion=float(np.median(np.linalg.norm(simulated, axis=1))),
     )
 
-
-def _com(centroid: np.ndarray, poses: np.ndarray) -> np.ndarray:
-    """[W, 2] world position of the centre of mass for [W, 3] tracked-frame poses."""
-    cos, sin = np.cos(poses[:, 2]), np.sin(poses[:, 2])
-    return poses[:, :2] + np.stack([cos * centroid[0] - sin * centroid[1], sin * centroid[0] + cos * centroid[1]], 1)

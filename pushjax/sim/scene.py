@@ -1,7 +1,7 @@
 """MuJoCo scenes of the MIT Push Dataset set-up: a steel plate on a table, pushed by a vertical cylinder.
 
-Naming convention (shared with :mod:`pushjax.render`): geom ``table`` (a plane, top surface at z = 0, one
-procedural material per surface); body ``object`` with the free joint ``object_joint``, whose body frame IS
+Naming convention (shared with :mod:`pushjax.render.renderer`): geom ``table`` (a plane, top surface at z = 0,
+one procedural material per surface); body ``object`` with the free joint ``object_joint``, whose body frame IS
 the object's tracked frame (origin on the mid-plane of the plate, z up); mocap body ``pusher`` holding a
 vertical cylinder of radius 4.76 mm; fixed world camera ``camera``.
 
@@ -50,8 +50,8 @@ Solver settings and why (see ``tests/sim`` for the resulting behaviour):
   at d0 = 0.1: a sliding contact under MuJoCo's soft elliptic cone pushes the plate up in proportion to the
   sliding speed, and with stiffer impedances the plate lifts off, drops and bounces every few steps (micrometres,
   but the friction drops out each time); d0 = 0.1 keeps sliding smooth up to ~50 mm/s at the price of a 0.2 mm
-  rest penetration (a soft table, invisible in the recorded planar poses; ``pushjax.render`` places the plate
-  on the table itself). Faster pushes still rock the plate slightly. Pusher contacts use d0 = 0.5.
+  rest penetration (a soft table, invisible in the recorded planar poses; ``pushjax.render.renderer`` places the
+  plate on the table itself). Faster pushes still rock the plate slightly. Pusher contacts use d0 = 0.5.
 * ``noslip_iterations`` 0 (NoSlip does not act on sliding contacts, and the creep is small without it) and the
   CG solver, which converges here to the same forces as Newton at about 60 % of the cost.
 
@@ -103,7 +103,7 @@ TIP_STIFFNESS = 100.0
 TIP_DAMPING = 2 * (TIP_STIFFNESS * TIP_MASS) ** 0.5
 """Vertical damping of the pusher tip, N s/m (critical)."""
 PUSHER_CLEARANCE = 1e-3
-"""Gap between the table and the bottom of the pusher in m (as ``pushjax.render`` places it)."""
+"""Gap between the table and the bottom of the pusher in m (as ``pushjax.render.renderer`` places it)."""
 CONTACT_SOLREF = (0.004, 1.0)
 """(time constant s, damping ratio) of every contact."""
 SUPPORT_SOLIMP = (0.1, 0.95, 0.001, 0.5, 2.0)

@@ -1,32 +1,64 @@
-"""Losses, the (vmapped) sweep trainer, orbax checkpoints, evaluation and training configs."""
+"""Training: losses, one model's train state and step, the sweep trainer of K models, checkpoints,
+the metrics log, evaluation and training configs.
 
-from pushjax.train import checkpoint, configs, evaluate, losses, train
-from pushjax.train.configs import TrainConfig, get_config
-from pushjax.train.train import (
-    ModelSpec,
-    SweepResult,
-    TrainState,
-    batch_indices,
-    create_train_state,
-    make_train_step,
-    subset_specs,
-    sweep,
+Modules:
+  batching: each model's training subset and seed (`ModelSpec`), its batch order and in-memory batches.
+  train_state: `TrainState`, the optimiser and the pure single-model train step.
+  sweep_trainer: `sweep`, training K models together (vmapped, unrolled or sequential), resumable.
+  checkpoint: orbax checkpoints of a (stacked) train state.
+  metrics_log: the sweep's ``metrics.csv``.
+  losses, evaluate, configs: the training losses, evaluation in the paper's units, configs.
+"""
+
+from pushjax.train import (
+    batching,
+    checkpoint,
+    configs,
+    evaluate,
+    losses,
+    metrics_log,
+    sweep_trainer,
+    train_state,
 )
+from pushjax.train.batching import (
+    EVALUATION_FIELDS,
+    MODEL_INPUT_FIELDS,
+    ModelSpec,
+    batch_indices,
+    examples_from_source,
+    gather,
+    model_fields,
+    subset_specs,
+)
+from pushjax.train.configs import TrainConfig, get_config
+from pushjax.train.train_state import TrainState, create_train_state, make_optimizer, make_train_step
+from pushjax.train.sweep_trainer import SWEEP_MODES, SweepResult, describe_specs, sweep
 
 __all__ = [
+    "batching",
     "checkpoint",
     "configs",
     "evaluate",
     "losses",
-    "train",
+    "metrics_log",
+    "sweep_trainer",
+    "train_state",
+    "EVALUATION_FIELDS",
+    "MODEL_INPUT_FIELDS",
+    "SWEEP_MODES",
     "ModelSpec",
     "SweepResult",
     "TrainConfig",
     "TrainState",
     "batch_indices",
     "create_train_state",
+    "describe_specs",
+    "examples_from_source",
+    "gather",
     "get_config",
+    "make_optimizer",
     "make_train_step",
+    "model_fields",
     "subset_specs",
     "sweep",
 ]

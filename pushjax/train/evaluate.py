@@ -18,11 +18,13 @@ from collections.abc import Mapping
 import jax
 import numpy as np
 
-from pushjax.models.networks import ERROR_OPTIONS, PushModel
+from pushjax import planar
+from pushjax.models import ERROR_OPTIONS, PushModel
 from pushjax.physics import lynch
-from pushjax.train.train import Examples, SweepResult, TrainState, model_fields
+from pushjax.train.batching import Examples, model_fields
+from pushjax.train.sweep_trainer import SweepResult
+from pushjax.train.train_state import TrainState
 
-M_TO_MM = 1000.0
 
 
 def predict(
@@ -73,9 +75,9 @@ def error_metrics(predictions: Mapping[str, np.ndarray], examples: Examples) -> 
     """Errors of `predictions` (outputs of `predict`) against the ground truth in `examples`."""
     true_motion = np.asarray(examples["motion"], np.float64)
     motion = np.asarray(predictions["motion"], np.float64)
-    translation_error = np.linalg.norm(motion[:, :2] - true_motion[:, :2], axis=-1) * M_TO_MM
+    translation_error = np.linalg.norm(motion[:, :2] - true_motion[:, :2], axis=-1) * planar.M_TO_MM
     rotation_error = np.degrees(np.abs(motion[:, 2] - true_motion[:, 2]))
-    zero_translation = np.linalg.norm(true_motion[:, :2], axis=-1).mean() * M_TO_MM
+    zero_translation = np.linalg.norm(true_motion[:, :2], axis=-1).mean() * planar.M_TO_MM
     zero_rotation = np.degrees(np.abs(true_motion[:, 2])).mean()
     metrics = {"count": float(len(motion))}
     for name, error, baseline in (
@@ -88,12 +90,12 @@ def error_metrics(predictions: Mapping[str, np.ndarray], examples: Examples) -> 
         metrics[f"{name}_percent_se"] = 100 * se / baseline
     if "object_pos" in predictions:
         metrics["pos_mm"], metrics["pos_mm_se"] = _mean_and_se(
-            np.linalg.norm(predictions["object_pos"] - examples["object_pos"], axis=-1) * M_TO_MM
+            np.linalg.norm(predictions["object_pos"] - examples["object_pos"], axis=-1) * planar.M_TO_MM
         )
     touching = np.asarray(examples["contact_flag"]) > 0.5
     if "contact" in predictions:
         metrics["contact_mm"], _ = _mean_and_se(
-            np.linalg.norm(predictions["contact"] - examples["contact"], axis=-1)[touching] * M_TO_MM
+            np.linalg.norm(predictions["contact"] - examples["contact"], axis=-1)[touching] * planar.M_TO_MM
         )
     if "normal" in predictions:
         valid = touching & (np.linalg.norm(predictions["normal"], axis=-1) > 0)

@@ -21,8 +21,12 @@ import jax
 import jax.numpy as jnp
 import optax
 
-M_TO_MM = 1000.0
+from pushjax.models import heads
+from pushjax.planar import M_TO_MM
+
 CONTACT_WEIGHT = 10.0
+LOSS_3D_PREDICTIONS = frozenset({"motion_given_contact", "s_logit"})
+"""The model outputs that `loss_3d` reads besides the object position."""
 
 Metrics = dict[str, jax.Array]
 
@@ -117,7 +121,11 @@ def _position_error(predictions, batch) -> jax.Array:
 
 
 def loss_for(variant: str, view: str):
-    """The loss of a model: `loss_3d` for physics variants with s in the free view, else `loss_2d`."""
-    if view == "free" and variant not in ("neural", "neural_dyn", "simple"):
+    """The loss of a `PushModel` of `variant` in `view`, by what its head predicts there.
+
+    `loss_3d` if it predicts the motion given contact and the contact indicator separately (the
+    physics variants with s in the free view), else `loss_2d`.
+    """
+    if LOSS_3D_PREDICTIONS <= heads.HEADS[variant].output_names(view):
         return loss_3d
     return loss_2d

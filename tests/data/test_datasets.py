@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 import tensorflow_datasets as tfds
 
-from pushjax.data import batches, configs
-from pushjax.data.builder import build, load
+from pushjax.data import configs
+from pushjax.data.builder import IncompleteRawDirError, build, load
 from pushjax.data.examples import ALL_FIELDS
 from pushjax.data.schema import FIELDS
 from pushjax.geometry import OBJECT_NAMES, THICKNESS
@@ -47,8 +47,14 @@ def _column(source, name):
     return np.array([source[i][name] for i in range(len(source))])
 
 
+def _read(source, indices):
+    """{field: [len(indices), ...] array} of the examples at `indices`, with the dtypes of `ALL_FIELDS`."""
+    examples = source.__getitems__([int(index) for index in indices])
+    return {name: np.asarray([example[name] for example in examples], ALL_FIELDS[name].dtype) for name in examples[0]}
+
+
 def _all(source):
-    return next(batches(source, len(source), seed=0, shuffle=False, drop_remainder=False))
+    return _read(source, range(len(source)))
 
 
 def test_fields_shapes_and_dtypes(smoke):
@@ -58,7 +64,7 @@ def test_fields_shapes_and_dtypes(smoke):
     for source in sources.values():
         example = source[0]
         assert set(example) == set(ALL_FIELDS) and set(FIELDS) <= set(example)
-        batch = next(batches(source, 8, seed=0))
+        batch = _read(source, range(8))
         for name, field in ALL_FIELDS.items():
             shape = tuple(size if dim in ("H", "W") else dim for dim in field.shape)
             assert batch[name].shape == (8, *shape), name
@@ -203,31 +209,14 @@ def test_repeated_push_under_scene_transforms(smoke):
     assert np.linalg.norm(recorded[0]) > 1e-3
 
 
-def test_batches_indices_epochs_and_determinism(smoke):
-    source = smoke("data_efficiency")["test"]
-    subset = np.arange(0, len(source), 3)
-    first = list(batches(source, 4, seed=1, indices=subset, num_epochs=2))
-    second = list(batches(source, 4, seed=1, indices=subset, num_epochs=2))
-    assert len(first) == 2 * (len(subset) // 4)
-    for a, b in zip(first, second):
-        np.testing.assert_array_equal(a["depth"], b["depth"])
-    seen = np.concatenate([batch["sequence_id"] for batch in first[:len(subset) // 4]])
-    allowed = set(_column(source, "sequence_id")[subset].tolist())
-    assert set(seen.tolist()) <= allowed
-    with pytest.raises(ValueError, match="indices"):
-        next(batches(source, 4, seed=0, indices=[len(source)]))
-    with pytest.raises(ValueError, match="batch_size"):
-        next(batches(source, 0, seed=0))
-
-
 def test_loading_never_imports_tensorflow(smoke, data_dir):
     smoke("data_efficiency")
     script = textwrap.dedent(f"""
         import sys
         import pushjax.data as data
         sources = data.load("data_efficiency", "smoke", data_dir={str(data_dir)!r})
-        batch = next(data.batches(sources["train"], 16, seed=0))
-        assert batch["depth"].shape == (16, 64, 64, 1)
+        examples = sources["train"].__getitems__(list(range(16)))
+        assert len(examples) == 16 and examples[0]["depth"].shape == (64, 64, 1)
         import tensorflow_datasets as tfds
         source = tfds.data_source("push_effects/data_efficiency_smoke", data_dir={str(data_dir)!r},
                                   split="test", download=False)
@@ -248,6 +237,27 @@ def test_cli_builds_a_dataset(tmp_path):
     assert result.returncode == 0, result.stderr[-3000:]
     assert "repeated_smoke: test 24 examples" in result.stdout
     assert len(load("repeated", "smoke", data_dir=tmp_path, split="test")) == 24
+
+
+def test_a_given_raw_dir_is_never_written(tmp_path):
+    raw_dir = tmp_path / "real_mit_files"
+    raw_dir.mkdir()
+    with pytest.raises(IncompleteRawDirError, match=r"raw_dir: 1 of 1 files .* missing under .*first: .*/"
+                                                    r"motion_surface=.*\.h5"):
+        build("repeated", "smoke", data_dir=tmp_path / "data", workers=1, progress=False, raw_dir=raw_dir)
+    assert not list(raw_dir.iterdir())
+
+
+def test_cli_refuses_an_incomplete_raw_dir(tmp_path):
+    raw_dir = tmp_path / "real_mit_files"
+    raw_dir.mkdir()
+    result = subprocess.run(
+        [sys.executable, "-m", "experiments.build_dataset", "--experiment=repeated", "--scale=smoke",
+         f"--data_dir={tmp_path / 'data'}", "--workers=1", f"--raw_dir={raw_dir}"],
+        capture_output=True, text=True, cwd=Path(__file__).resolve().parents[2])
+    assert result.returncode != 0 and "Traceback" not in result.stderr, result.stderr[-3000:]
+    assert "--raw_dir: 1 of 1 files" in result.stderr
+    assert not list(raw_dir.iterdir())
 
 
 def test_seeded_configs_and_bad_names():

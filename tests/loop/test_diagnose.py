@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from pushjax.data.mit_push import iter_pushes
 from pushjax.loop import diagnose
-from pushjax.loop.examples import build_examples
+from pushjax.loop.windows import build_examples
+from pushjax.mit.files import iter_pushes
 
 
 @pytest.fixture(scope="module")

@@ -6,9 +6,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from pushjax.data.mit_push import iter_pushes
 from pushjax.loop import correction, fit, metrics, select
-from pushjax.loop.examples import build_examples, split_by_sequence
+from pushjax.loop.windows import build_examples, split_by_sequence
+from pushjax.mit.files import iter_pushes
 
 TRUE = {"cof_offset": {"offset": np.array([0.008, -0.004])},
         "friction_ratio": {"log_scale": np.array(np.log(1.4))}}

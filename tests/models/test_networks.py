@@ -7,11 +7,13 @@ import pytest
 
 from pushjax.models import VARIANTS, ModelConfig, PushModel, count_parameters
 from pushjax.train import losses
+from pushjax.data import configs as data_configs
 from pushjax.train.configs import get_config
+from tests.tiny_configs import TINY_SMOKE
 
 from .synthetic import synthetic_examples
 
-TINY = get_config("smoke").model
+TINY = TINY_SMOKE.model
 
 
 @pytest.fixture(scope="module")
@@ -114,7 +116,7 @@ def test_physics_is_a_swappable_function(batch):
 
 
 def test_paper_scale_parameter_counts(batch):
-    paper = get_config("paper").model
+    paper = get_config(data_configs.get_config("data_efficiency", "paper")).model
     images = {**batch, "depth": jnp.zeros((8, 128, 128, 1))}
 
     def counts(variant):

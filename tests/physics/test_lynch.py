@@ -375,3 +375,57 @@ def test_check_inputs_rejects_bad_input(name, value, message):
     args[name] = value
     with pytest.raises(ValueError, match=message):
         lynch.check_inputs(**args)
+
+
+def _valid_pushes():
+    """Four valid pushes."""
+    return dict(contact=np.full((4, 2), [0.01, -0.02]), normal=np.array([0.0, 1.0]), action=np.array([0.0, 0.01]),
+                l=np.full(4, 0.04), mu=0.5, s=1.0)
+
+
+@pytest.mark.parametrize(
+    "name, value, message",
+    [
+        ("contact", np.zeros(3), r"contact: expected shape \[\.\.\., 2\], got \(3,\)"),
+        ("normal", np.zeros(()), r"normal: expected shape \[\.\.\., 2\], got \(\)"),
+        ("action", np.zeros((4, 3)), r"action: expected shape \[\.\.\., 2\], got \(4, 3\)"),
+        ("contact", np.array([0.01, 0.02], np.complex64),
+         "contact: expected a real numeric array, got dtype complex64"),
+        ("l", np.complex64(0.04), "l: expected a real numeric array, got dtype complex64"),
+        ("s", True, "s: expected a real numeric array, got dtype bool"),
+        ("mu", np.ones(3, bool), "mu: expected a real numeric array, got dtype bool"),
+        ("l", np.full(5, 0.04), r"batch shapes do not broadcast: contact \(4,\), .* l \(5,\)"),
+    ],
+)
+@pytest.mark.parametrize("transform", ["jit", "vmap", "grad"])
+def test_predict_checks_shapes_and_dtypes_when_traced(name, value, message, transform):
+    arguments = {**_valid_pushes(), name: value}
+    if transform == "jit":
+        call = jax.jit(lambda args: lynch.predict(**args))
+    elif transform == "vmap":  # a batch of one: the check sees the shapes without the mapped axis
+        arguments = jax.tree.map(lambda array: np.asarray(array)[None], arguments)
+        call = jax.vmap(lambda args: lynch.predict(**args))
+    else:  # the gradient with respect to another (valid, float) argument
+        wrt = "action" if name != "action" else "normal"
+        point = arguments.pop(wrt)
+        call = lambda args: jax.grad(lambda x: lynch.predict(**args, **{wrt: x}).sum())(point)  # noqa: E731
+    with pytest.raises(ValueError, match=message):
+        call(arguments)
+
+
+@pytest.mark.parametrize(
+    "function, arguments, message",
+    [
+        (lynch.effective_push_velocity, dict(contact=np.zeros(3), normal=np.ones(2), action=np.ones(2), l=0.04, mu=0.5),
+         r"contact: expected shape \[\.\.\., 2\]"),
+        (lynch.effective_push_velocity, dict(contact=np.zeros(2), normal=np.ones(2), action=np.ones(2, complex),
+                                             l=0.04, mu=0.5), "action: expected a real numeric array"),
+        (lynch.object_velocity, dict(contact=np.zeros(2), v_p=np.ones(3), l=0.04),
+         r"v_p: expected shape \[\.\.\., 2\]"),
+        (lynch.object_velocity, dict(contact=np.zeros(2), v_p=np.ones(2), l=True), "l: expected a real numeric array"),
+    ],
+)
+def test_stages_check_shapes_and_dtypes(function, arguments, message):
+    with pytest.raises(ValueError, match=message):
+        function(**arguments)
+

@@ -1,6 +1,9 @@
 """Tests for pushjax.render.renderer: MuJoCo depth images agree with the JAX camera model to 1 mm / 1 px."""
 
 import os
+import subprocess
+import sys
+from pathlib import Path
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
@@ -191,6 +194,36 @@ def test_scene_convention_violations_raise(model):
         rnd.DepthRenderer(mujoco.MjModel.from_xml_string(SCENE_XML.replace('"pusher"', '"tool"')), camera)
     with pytest.raises(ValueError, match="mocap"):
         rnd.DepthRenderer(mujoco.MjModel.from_xml_string(SCENE_XML.replace('mocap="true"', "")), camera)
+
+
+@pytest.mark.parametrize("egl_exit_hook_runs", ["first", "last"])
+def test_renderers_left_open_exit_silently(egl_exit_hook_runs):
+    """Renderers never closed (held to the end, in a reference cycle) free their context without a word at exit,
+    whether MuJoCo's EGL display is terminated before or after they are freed."""
+    script = f"""
+import weakref
+if {egl_exit_hook_runs == "last"!r}:
+    weakref.finalize(int, int)  # registers weakref's exit hook first, so that it runs after EGL's
+import mujoco
+from pushjax.render import camera, renderer
+model = mujoco.MjModel.from_xml_string({SCENE_XML!r})
+held = renderer.DepthRenderer(model, camera.top_down_camera(32, 32))
+held.depth([0.0, 0.0, 0.0], [0.1, 0.0])
+in_a_cycle = renderer.DepthRenderer(model, camera.free_camera(32, 32))
+in_a_cycle.itself = in_a_cycle
+print(in_a_cycle.depth([0.0, 0.0, 0.0], [0.1, 0.0]).shape)
+"""
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                            cwd=Path(__file__).resolve().parents[2], env={**os.environ, "MUJOCO_GL": "egl"})
+    assert (result.returncode, result.stdout, result.stderr) == (0, "(32, 32)\n", "")
+
+
+def test_close_twice_and_context_manager(model):
+    renderer = rnd.DepthRenderer(model, cam.top_down_camera(32, 32))
+    renderer.close()
+    renderer.close()
+    with rnd.DepthRenderer(model, cam.top_down_camera(32, 32)) as renderer:
+        assert renderer.depth(OBJECT_POSE, PUSHER_OUT_OF_VIEW).shape == (32, 32)
 
 
 def test_bad_state_raises(top_down):

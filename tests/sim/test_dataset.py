@@ -1,14 +1,16 @@
 """Tests for pushjax.sim.dataset and experiments/record_pushes: determinism, resuming, attributes, the CLI."""
 
+import json
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
 
-from pushjax.data.mit_push import load_push, parse_push_file_name, read_raw_push
+from pushjax.mit.files import load_push, parse_push_file_name, read_raw_push, write_push
 from pushjax.sim import dataset
 from pushjax.sim.effects import Effects
 
@@ -43,6 +45,71 @@ def test_existing_files_are_skipped(tmp_path):
     resumed = dataset.record_pushes(tmp_path, **arguments)
     assert resumed.written == [first.written[2]] and len(resumed.skipped) == 3
     assert files(tmp_path) == before
+
+
+def test_invalid_existing_files_are_rerecorded(tmp_path):
+    arguments = dict(objects=["rect1"], surfaces=["abs"], pushes=3, seed=2, velocities=(20.0,), workers=1,
+                     progress=False)
+    first = dataset.record_pushes(tmp_path, **arguments)
+    before = files(tmp_path)
+    truncated, overwritten, intact = first.written
+    truncated.write_bytes(truncated.read_bytes()[:2000])
+    overwritten.write_bytes(b"not an HDF5 file")
+    again = dataset.record_pushes(tmp_path, **arguments)
+    assert sorted(again.rerecorded) == sorted(again.written) == sorted([truncated, overwritten])
+    assert again.skipped == [intact]
+    assert files(tmp_path) == before
+
+
+RECORDED = dict(objects=["rect1"], surfaces=["abs"], pushes=1, seed=4, velocities=(20.0,), accelerations=(0.0,),
+                repeats=1, effects=Effects(table_tilt_deg=1.0), declare_effects=True, support="grid")
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory):
+    """A folder recorded with `RECORDED`."""
+    out_dir = tmp_path_factory.mktemp("recorded")
+    dataset.record_pushes(out_dir, **RECORDED, workers=1, progress=False)
+    return out_dir
+
+
+def test_manifest_records_the_settings(recorded):
+    settings = json.loads((recorded / dataset.MANIFEST_NAME).read_text())["settings"]
+    assert settings["seed"] == 4 and settings["velocities"] == [20.0] and settings["support"] == "grid"
+    assert Effects.from_json(json.dumps(settings["effects"])) == RECORDED["effects"]
+
+
+@pytest.mark.parametrize("change", [
+    dict(seed=5), dict(effects=Effects(table_tilt_deg=2.0)), dict(declare_effects=False), dict(support="hull"),
+    dict(velocities=(50.0,)), dict(velocities=(20.0, 50.0)), dict(accelerations=(0.0, 100.0)), dict(repeats=2),
+])
+def test_resume_with_other_settings_is_refused_naming_them(recorded, change):
+    before = files(recorded)
+    with pytest.raises(dataset.OutDirConflictError) as raised:
+        dataset.record_pushes(recorded, **{**RECORDED, **change}, workers=1, progress=False)
+    message = str(raised.value)
+    assert "\n" not in message and str(recorded) in message and dataset.MANIFEST_NAME in message
+    assert all(f" {setting} " in message for setting in change), message
+    assert files(recorded) == before
+
+
+def test_more_pushes_objects_and_surfaces_with_the_same_settings_add_to_the_folder(tmp_path):
+    settings = {**RECORDED, "pushes": 2, "objects": ["rect1", "tri1"], "surfaces": ["abs", "pu"]}
+    together = dataset.record_pushes(tmp_path / "together", **settings, workers=1, progress=False)
+    dataset.record_pushes(tmp_path / "added", **RECORDED, workers=1, progress=False)
+    added = dataset.record_pushes(tmp_path / "added", **settings, workers=1, progress=False)
+    assert len(together.written) == 8 and len(added.written) == 7 and len(added.skipped) == 1
+    assert files(tmp_path / "added") == files(tmp_path / "together")
+
+
+def test_a_folder_not_made_by_record_pushes_is_refused(tmp_path):
+    foreign = write_push(tmp_path / "abs" / "rect1" / "real.h5", None, *[
+        np.column_stack([np.arange(3) / 250.0, np.zeros((3, 3))])] * 3)
+    content = foreign.read_bytes()
+    with pytest.raises(dataset.OutDirConflictError, match=rf"1 \.h5 file.*no {dataset.MANIFEST_NAME}"):
+        dataset.record_pushes(tmp_path, ["rect1"], ["abs"], pushes=1, workers=1, progress=False)
+    assert [path.name for path in tmp_path.rglob("*") if path.is_file()] == ["real.h5"]
+    assert foreign.read_bytes() == content
 
 
 def test_files_follow_the_mit_layout_and_declare_effects(tmp_path):
@@ -114,9 +181,51 @@ def test_cli_records_and_resumes(tmp_path):
              "--declare_effects=false"]
     result = run_cli(*flags)
     assert result.returncode == 0, result.stderr
-    assert "wrote 4 files" in result.stdout
+    assert "wrote 4 files (0 replacing invalid files)" in result.stdout
     assert len(list(tmp_path.rglob("*.h5"))) == 4
-    assert "skipped 4" in run_cli(*flags).stdout
+    assert "reused 4 valid existing files" in run_cli(*flags).stdout
+    next(tmp_path.rglob("*.h5")).write_bytes(b"truncated")
+    assert "wrote 1 files (1 replacing invalid files), reused 3" in run_cli(*flags).stdout
+    refused = run_cli(*[flag for flag in flags if not flag.startswith("--seed")], "--seed=5")
+    assert refused.returncode != 0 and "Traceback" not in refused.stderr
+    assert " seed " in refused.stderr and "pushjax_manifest.json" in refused.stderr
+
+
+CLI_FLAGS = ["--objects=rect1", "--surfaces=abs", "--velocities=20", "--pushes=4", "--seed=6", "--workers=1"]
+
+
+def test_cli_runs_at_once_in_one_folder_give_the_files_of_one_run(tmp_path):
+    alone = run_cli(f"--out_dir={tmp_path / 'alone'}", *CLI_FLAGS)
+    assert alone.returncode == 0, alone.stderr
+    command = [sys.executable, "-m", "experiments.record_pushes", f"--out_dir={tmp_path / 'shared'}", *CLI_FLAGS]
+    runs = [subprocess.Popen(command, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            for _ in range(2)]
+    for run in runs:
+        _, stderr = run.communicate(timeout=120)
+        assert run.returncode == 0, stderr
+    assert files(tmp_path / "shared") == files(tmp_path / "alone")
+    manifest = dataset.MANIFEST_NAME
+    assert (tmp_path / "shared" / manifest).read_bytes() == (tmp_path / "alone" / manifest).read_bytes()
+    assert not [path for path in (tmp_path / "shared").rglob("*") if path.name.endswith(".partial")]
+
+
+def test_cli_killed_and_resumed_gives_the_files_of_one_run(tmp_path):
+    alone = run_cli(f"--out_dir={tmp_path / 'alone'}", *CLI_FLAGS)
+    assert alone.returncode == 0, alone.stderr
+    flags = [f"--out_dir={tmp_path / 'killed'}", *CLI_FLAGS]
+    run = subprocess.Popen([sys.executable, "-m", "experiments.record_pushes", *flags], cwd=REPO,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while not list((tmp_path / "killed").rglob("*.h5")) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    run.kill()
+    run.wait()
+    written_before_kill = len(list((tmp_path / "killed").rglob("*.h5")))
+    assert 1 <= written_before_kill < 4
+    resumed = run_cli(*flags)
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"reused {written_before_kill} valid existing files" in resumed.stdout
+    assert files(tmp_path / "killed") == files(tmp_path / "alone")
 
 
 @pytest.mark.parametrize("flag, message", [

@@ -1,11 +1,12 @@
-"""Tests for pushjax.sim.push: the MIT protocol, the recorded streams and the physics of each effect."""
+"""Tests for pushjax.sim.push: the simulated MIT protocol, the recorded streams and the physics of each effect."""
 
 import mujoco
 import numpy as np
 import pytest
 
-from pushjax.data.mit_push import PushParams
-from pushjax.geometry import PUSHER_RADIUS, get_object
+from pushjax.geometry import get_object
+from pushjax.mit import protocol
+from pushjax.mit.files import PushParams
 from pushjax.sim import push
 from pushjax.sim.effects import Effects
 from pushjax.sim.push import Simulator, simulate_push
@@ -31,52 +32,13 @@ def tip_in_object_frame(recording):
 
 
 def stop_sample(p):
-    return int(np.ceil(push.push_duration(p) * push.SAMPLE_RATE))
-
-
-def test_sample_push_draws_from_the_mit_grid():
-    rng = np.random.default_rng(0)
-    drawn = [push.sample_push("hex", "pu", rng, velocities=(20.0, 50.0), accelerations=(0.0, 500.0))
-             for _ in range(1000)]
-    assert {p.side for p in drawn} == set(range(6))
-    assert {p.point for p in drawn} == {k / 10 for k in range(11)}
-    assert {p.angle for p in drawn} == {round(a, 3) for a in push.MIT_ANGLES}
-    assert {p.velocity for p in drawn} == {20.0, 50.0} and {p.acceleration for p in drawn} == {0.0, 500.0}
-    assert all(p.surface == "pu" and p.shape == "hex" for p in drawn)
-    again = push.sample_push("hex", "pu", np.random.default_rng(0), velocities=(20.0, 50.0),
-                             accelerations=(0.0, 500.0))
-    assert again == drawn[0]
-    assert set(push.side_points("ellip1")) == {k / 10 for k in range(10)}
-    assert len(push.side_points("tri2")) == 11
-
-
-def test_pusher_line_starts_before_the_contact():
-    obj = get_object("tri2")
-    p = params("tri2", side=1, point=0.3, angle=0.5)
-    start, direction = push.pusher_line(obj, p)
-    point, inward = obj.side_point(1, 0.3)
-    assert np.linalg.norm(direction) == pytest.approx(1.0)
-    assert direction @ inward == pytest.approx(np.cos(0.5))
-    assert inward[0] * direction[1] - inward[1] * direction[0] == pytest.approx(np.sin(0.5))
-    np.testing.assert_allclose(start + push.APPROACH_DISTANCE * direction, point - PUSHER_RADIUS * inward)
-
-
-def test_pusher_motion_constant_and_accelerating():
-    constant = params(velocity=50.0)
-    distance, speed = push.pusher_motion(constant, np.array([0.0, 0.5, 2.0]))
-    np.testing.assert_allclose(distance, [0.0, 0.025, push.APPROACH_DISTANCE + push.PUSH_DISTANCE])
-    np.testing.assert_allclose(speed, [0.05, 0.05, 0.0])
-    accelerating = params(velocity=300.0, acceleration=500.0)
-    distance, speed = push.pusher_motion(accelerating, np.array([0.0, 0.2, 10.0]))
-    np.testing.assert_allclose(distance, [0.0, 0.5 * 0.5 * 0.2 ** 2, 0.053])
-    np.testing.assert_allclose(speed, [0.0, 0.1, 0.0])
-    assert push.push_duration(accelerating) == pytest.approx(np.sqrt(2 * 0.053 / 0.5))
+    return int(np.ceil(protocol.push_duration(p) * push.SAMPLE_RATE))
 
 
 def test_recording_layout():
     p = params(velocity=50.0)
     recording = simulate_push(p)
-    samples = int(np.ceil((push.push_duration(p) + push.POST_PUSH_DURATION) * 250)) + 1
+    samples = int(np.ceil((protocol.push_duration(p) + push.POST_PUSH_DURATION) * 250)) + 1
     for stream in (recording.tip_pose, recording.object_pose, recording.ft_wrench):
         assert stream.shape == (samples, 4)
         np.testing.assert_allclose(stream[:, 0], np.arange(samples) / 250)
@@ -91,8 +53,8 @@ def test_central_push_translates_with_the_pusher():
     p = params()
     recording = simulate_push(p)
     displacement, rotation = motion(recording)
-    direction = push.pusher_line("rect1", p)[1]
-    assert displacement @ direction == pytest.approx(push.PUSH_DISTANCE, rel=0.05)
+    direction = protocol.pusher_line("rect1", p)[1]
+    assert displacement @ direction == pytest.approx(protocol.PUSH_DISTANCE, rel=0.05)
     assert abs(np.degrees(rotation)) < 1.0
     pushing = recording.ft_wrench[50:stop_sample(p) - 5]
     weight = get_object("rect1").mass * 9.81
@@ -110,7 +72,7 @@ def test_fast_push_slides_on_after_the_pusher_stops():
     stop = stop_sample(p)
     sliding = recording.true_object_pose[-1, 1:3] - recording.true_object_pose[stop, 1:3]
     assert np.linalg.norm(sliding) > 0.01
-    assert sliding @ push.pusher_line("rect1", p)[1] > 0
+    assert sliding @ protocol.pusher_line("rect1", p)[1] > 0
     assert np.all(recording.ft_wrench[stop + 5:, 1:] == 0)
 
 
@@ -176,7 +138,7 @@ def test_rim_pressure_reduces_rotation():
 def test_anisotropic_friction_turns_the_sliding_direction():
     """A slanted central push: the plate slides preferably along its low-friction axis."""
     p = params(angle=0.6)
-    early = int(round((push.APPROACH_DISTANCE + 0.01) / 0.02 * 250))
+    early = int(round((protocol.APPROACH_DISTANCE + 0.01) / 0.02 * 250))
 
     def sideways(anisotropy):
         pose = simulate_push(p, Effects(friction_anisotropy=anisotropy)).true_object_pose

@@ -2,7 +2,7 @@
 
 import pytest
 
-from pushjax.train import train
+from pushjax import train
 
 FIELDS = ("depth", "point_cloud", *train.MODEL_INPUT_FIELDS, *train.EVALUATION_FIELDS)
 
@@ -29,3 +29,9 @@ def smoke(data_dir):
 def smoke_viewpoint(data_dir):
     """split -> examples of the smoke ``viewpoint`` dataset (free camera, point clouds)."""
     return _examples(data_dir, "viewpoint")
+
+
+@pytest.fixture(scope="module")
+def examples(smoke):
+    """The training split of `smoke`."""
+    return smoke["train"]

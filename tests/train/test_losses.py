@@ -2,6 +2,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from pushjax.models import VARIANTS, VIEWS
 from pushjax.train import losses
 
 
@@ -55,3 +56,10 @@ def test_loss_choice():
     assert losses.loss_for("hybrid", "free") is losses.loss_3d
     assert losses.loss_for("neural", "free") is losses.loss_2d
     assert losses.loss_for("hybrid", "top_down") is losses.loss_2d
+
+
+@pytest.mark.parametrize("view", VIEWS)
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_loss_choice_of_every_variant_and_view(variant, view):
+    separate_contact_indicator = view == "free" and variant in ("hybrid", "error", "error_grad", "error_norm")
+    assert losses.loss_for(variant, view) is (losses.loss_3d if separate_contact_indicator else losses.loss_2d)

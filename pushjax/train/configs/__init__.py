@@ -1,13 +1,12 @@
-"""Training configurations per scale: `smoke` (tests, seconds), `cpu` (a laptop, minutes), `paper`."""
+"""Training configurations per scale (`pushjax.data.SCALES`): `smoke` (tests, seconds), `cpu` (a laptop), `paper`."""
 
 from __future__ import annotations
 
 import dataclasses
 import importlib
 
-from pushjax.models.networks import ModelConfig
-
-SCALES = ("smoke", "cpu", "paper")
+from pushjax.data.configs import DatasetConfig
+from pushjax.models import ModelConfig
 
 
 @dataclasses.dataclass(frozen=True)
@@ -47,8 +46,13 @@ class TrainConfig:
         return dataclasses.replace(self, model=model)
 
 
-def get_config(scale: str) -> TrainConfig:
-    """The `TrainConfig` of `scale` (one of `SCALES`)."""
-    if scale not in SCALES:
-        raise ValueError(f"scale: expected one of {SCALES}, got {scale!r}")
-    return importlib.import_module(f"pushjax.train.configs.{scale}").get_config()
+def get_config(dataset: DatasetConfig) -> TrainConfig:
+    """The `TrainConfig` for training on `dataset`.
+
+    The dataset's scale picks the architecture and schedule (``pushjax/train/configs/<scale>.py``), its camera
+    the model's view and its glimpse size the model's (the glimpse is cut from the dataset's images, so its
+    size in pixels belongs to the data).
+    """
+    config = importlib.import_module(f"pushjax.train.configs.{dataset.scale}").get_config()
+    model = dataclasses.replace(config.model, view=dataset.camera, glimpse_size=dataset.glimpse_size)
+    return dataclasses.replace(config, model=model)

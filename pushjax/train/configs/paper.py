@@ -1,9 +1,10 @@
-"""Paper scale (Kloss et al., Sec. V-B): 80 x 80 px glimpse, Adam 1e-4, batch 32, 75 k steps.
+"""Paper scale (Kloss et al., Sec. V-B): Adam 1e-4, batch 32, 75 k steps.
 
-Prediction part (glimpse encoder + FC stack): about 1.8 M parameters, 2.7 M with the error term.
+With the paper-scale datasets' 80 x 80 px glimpses, the prediction part (glimpse encoder + FC stack) has about
+1.8 M parameters, 2.7 M with the error term.
 """
 
-from pushjax.models.networks import ModelConfig
+from pushjax.models import ModelConfig
 from pushjax.train.configs import TrainConfig
 
 

@@ -1,20 +1,11 @@
 """Smoke scale: tiny networks that train in seconds on 2 CPU cores (tests, CI)."""
 
-from pushjax.models.networks import ModelConfig
+from pushjax.models import ModelConfig
 from pushjax.train.configs import TrainConfig
 
 
 def get_config() -> TrainConfig:
-    model = ModelConfig(
-        glimpse_size=12,
-        glimpse_features=(8, 8, 8),
-        glimpse_kernel=3,
-        locator_conv_features=(8, 8, 8, 8),
-        locator_deconv_features=(8, 8),
-        head_features=(64, 32),
-        error_features=(32, 16),
-    )
-    return TrainConfig(
-        model=model, learning_rate=1e-3, batch_size=16, num_steps=200, log_every=20,
-        checkpoint_every=50, eval_batch_size=64,
-    )
+    model = ModelConfig(glimpse_features=(8, 8, 8), glimpse_kernel=3, locator_conv_features=(8, 8, 8, 8),
+                        locator_deconv_features=(8, 8), head_features=(64, 32), error_features=(32, 16))
+    return TrainConfig(model=model, learning_rate=1e-3, batch_size=16, num_steps=200, log_every=20,
+                       checkpoint_every=50, eval_batch_size=64)

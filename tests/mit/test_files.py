@@ -1,8 +1,10 @@
-"""Tests for pushjax.data.mit_push: file names, HDF5 round trips, cleaning, resampling and iteration."""
+"""Tests for pushjax.mit.files: file names, HDF5 round trips, cleaning, resampling and iteration."""
 
+import concurrent.futures
 import json
 import logging
 import math
+import multiprocessing
 import time
 from pathlib import Path
 
@@ -12,8 +14,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pushjax.data import mit_push
-from pushjax.data.mit_push import PushFileError, PushParams
+from pushjax.mit import files
+from pushjax.mit.files import PushFileError, PushParams
 
 PARAMS = PushParams(surface="abs", shape="rect1", acceleration=0.0, velocity=20.0, side=0, point=0.7, angle=-0.175,
                     repetition=4)
@@ -41,21 +43,21 @@ def write_file(path, **datasets):
 # File names.
 
 def test_canonical_name_and_round_trip():
-    assert mit_push.push_file_name(PARAMS) == CANONICAL_NAME
-    assert mit_push.parse_push_file_name(CANONICAL_NAME) == PARAMS
+    assert files.push_file_name(PARAMS) == CANONICAL_NAME
+    assert files.parse_push_file_name(CANONICAL_NAME) == PARAMS
     single = PushParams("delrin", "tri2", 0.0, 150.0, 2, 0.0, 0.349)
-    assert mit_push.push_file_name(single) == "motion_surface=delrin_shape=tri2_a=0_v=150_i=2.000_s=0.000_t=0.349.h5"
-    assert mit_push.parse_push_file_name(mit_push.push_file_name(single)) == single
+    assert files.push_file_name(single) == "motion_surface=delrin_shape=tri2_a=0_v=150_i=2.000_s=0.000_t=0.349.h5"
+    assert files.parse_push_file_name(files.push_file_name(single)) == single
 
 
 def test_parse_accepts_any_float_formatting_and_paths():
     name = "dir/motion_surface=pu_shape=ellip2_a=100.0_v=1.0e1_i=3_s=.5_t=-1.75E-1_rep=12.h5"
-    assert mit_push.parse_push_file_name(Path(name)) == PushParams("pu", "ellip2", 100.0, 10.0, 3, 0.5, -0.175, 12)
+    assert files.parse_push_file_name(Path(name)) == PushParams("pu", "ellip2", 100.0, 10.0, 3, 0.5, -0.175, 12)
 
 
 def test_name_rounds_to_three_decimals_without_negative_zero():
     params = PushParams("abs", "hex", 0.0, 12.5, 1, 0.12345, -0.0001)
-    assert mit_push.push_file_name(params) == "motion_surface=abs_shape=hex_a=0_v=12.5_i=1.000_s=0.123_t=0.000.h5"
+    assert files.push_file_name(params) == "motion_surface=abs_shape=hex_a=0_v=12.5_i=1.000_s=0.123_t=0.000.h5"
 
 
 def test_velocity_and_acceleration_in_si():
@@ -73,7 +75,7 @@ def test_velocity_and_acceleration_in_si():
 def test_name_round_trip_property(acceleration, velocity, side, point, angle, repetition):
     params = PushParams("plywood", "butter", float(acceleration), float(velocity), side, point / 1000,
                         angle / 1000, repetition)
-    assert mit_push.parse_push_file_name(mit_push.push_file_name(params)) == params
+    assert files.parse_push_file_name(files.push_file_name(params)) == params
 
 
 @pytest.mark.parametrize("name", [
@@ -90,7 +92,7 @@ def test_name_round_trip_property(acceleration, velocity, side, point, angle, re
 ])
 def test_malformed_names_raise_naming_the_file(name):
     with pytest.raises(ValueError, match=name.replace(".", r"\.")) as error:
-        mit_push.parse_push_file_name(name)
+        files.parse_push_file_name(name)
     assert error.value.reason == "unparseable file name"
 
 
@@ -105,7 +107,7 @@ def test_invalid_params_raise(kwargs):
 
 
 def test_push_file_path(tmp_path):
-    assert mit_push.push_file_path(tmp_path, PARAMS) == tmp_path / "abs" / "rect1" / CANONICAL_NAME
+    assert files.push_file_path(tmp_path, PARAMS) == tmp_path / "abs" / "rect1" / CANONICAL_NAME
 
 
 # Writing and raw reading.
@@ -114,8 +116,8 @@ def test_raw_round_trip_is_exact_and_adds_nothing_without_attributes(tmp_path):
     rng = np.random.default_rng(0)
     tip, obj, wrench = (np.column_stack([np.sort(rng.uniform(0, 1, n)), rng.normal(size=(n, 3))])
                         for n in (30, 31, 29))
-    path = mit_push.write_push(mit_push.push_file_path(tmp_path, PARAMS), PARAMS, tip, obj, wrench)
-    raw = mit_push.read_raw_push(path)
+    path = files.write_push(files.push_file_path(tmp_path, PARAMS), PARAMS, tip, obj, wrench)
+    raw = files.read_raw_push(path)
     assert raw.path == path and raw.params == PARAMS and raw.attributes == {}
     np.testing.assert_array_equal(raw.tip_pose, tip)
     np.testing.assert_array_equal(raw.object_pose, obj)
@@ -132,8 +134,8 @@ def test_attributes_round_trip(tmp_path):
     effects = {"floor_friction_patch": {"mu": 0.4}}
     attributes = {"pushjax_effects": json.dumps(effects), "pushjax_version": "0.1.0", "seed": 7, "noisy": True,
                   "gain": 0.5, "offsets": np.array([1.0, 2.0])}
-    path = mit_push.write_push(tmp_path / "x.h5", None, *linear_push(), attributes=attributes)
-    raw = mit_push.read_raw_push(path)
+    path = files.write_push(tmp_path / "x.h5", None, *linear_push(), attributes=attributes)
+    raw = files.read_raw_push(path)
     assert raw.params is None
     assert list(raw.attributes) == sorted(attributes)
     assert {k: v for k, v in raw.attributes.items() if k != "offsets"} == {
@@ -141,19 +143,42 @@ def test_attributes_round_trip(tmp_path):
     assert type(raw.attributes["seed"]) is int and type(raw.attributes["noisy"]) is bool
     np.testing.assert_array_equal(raw.attributes["offsets"], [1.0, 2.0])
     assert raw.declared_effects == effects
-    assert mit_push.load_push(path).declared_effects == effects
+    assert files.load_push(path).declared_effects == effects
 
 
 def test_writer_is_deterministic(tmp_path):
     tip, obj, wrench = linear_push()
     attributes = {"pushjax_effects": "[]", "seed": 3}
-    first = mit_push.write_push(tmp_path / "a" / CANONICAL_NAME, PARAMS, tip, obj, wrench, attributes)
-    second = mit_push.write_push(tmp_path / "b" / CANONICAL_NAME, PARAMS, tip, obj, wrench, dict(reversed(
+    first = files.write_push(tmp_path / "a" / CANONICAL_NAME, PARAMS, tip, obj, wrench, attributes)
+    second = files.write_push(tmp_path / "b" / CANONICAL_NAME, PARAMS, tip, obj, wrench, dict(reversed(
         attributes.items())))
     first_bytes = first.read_bytes()
     time.sleep(1.1)  # HDF5 time stamps have 1 s resolution: any stored time would now differ.
-    mit_push.write_push(first, PARAMS, tip, obj, wrench, attributes)  # overwrite in place
+    files.write_push(first, PARAMS, tip, obj, wrench, attributes)  # overwrite in place
     assert first_bytes == second.read_bytes() == first.read_bytes()
+
+
+def _write_when_all_are_ready(task):
+    """Worker: signals ready, waits for the other writers, then writes `path` `writes` times."""
+    path, ready_dir, writer, writers, writes = task
+    (ready_dir / str(writer)).touch()
+    while len(list(ready_dir.iterdir())) < writers:
+        time.sleep(0.001)
+    tip, obj, wrench = linear_push(n=2000)
+    for _ in range(writes):
+        files.write_push(path, PARAMS, tip, obj, wrench, {"seed": 3})
+
+
+def test_concurrent_writers_of_one_file_never_collide(tmp_path):
+    path = files.push_file_path(tmp_path / "shared", PARAMS)
+    ready = tmp_path / "ready"
+    ready.mkdir()
+    writers = 2
+    with concurrent.futures.ProcessPoolExecutor(writers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        list(pool.map(_write_when_all_are_ready, [(path, ready, writer, writers, 30) for writer in range(writers)]))
+    alone = files.write_push(tmp_path / "alone" / CANONICAL_NAME, PARAMS, *linear_push(n=2000), {"seed": 3})
+    assert path.read_bytes() == alone.read_bytes()
+    assert [p.name for p in path.parent.iterdir()] == [CANONICAL_NAME]  # no temporary file left behind
 
 
 @pytest.mark.parametrize("change, message", [
@@ -164,22 +189,22 @@ def test_writer_is_deterministic(tmp_path):
 def test_writer_validates_streams(tmp_path, change, message):
     tip, obj, wrench = linear_push()
     with pytest.raises(ValueError, match=message):
-        mit_push.write_push(tmp_path / "x.h5", None, change(tip), obj, wrench)
+        files.write_push(tmp_path / "x.h5", None, change(tip), obj, wrench)
     assert not list(tmp_path.iterdir())
 
 
 def test_writer_checks_name_and_attributes(tmp_path):
     with pytest.raises(ValueError, match="does not end in the file name of params"):
-        mit_push.write_push(tmp_path / "x.h5", PARAMS, *linear_push())
+        files.write_push(tmp_path / "x.h5", PARAMS, *linear_push())
     with pytest.raises(ValueError, match="attribute 'effects' must be"):
-        mit_push.write_push(tmp_path / "x.h5", None, *linear_push(), attributes={"effects": {"a": 1}})
+        files.write_push(tmp_path / "x.h5", None, *linear_push(), attributes={"effects": {"a": 1}})
 
 
 def test_truncated_file_raises_naming_it(tmp_path):
-    path = mit_push.write_push(mit_push.push_file_path(tmp_path, PARAMS), PARAMS, *linear_push(n=500))
+    path = files.write_push(files.push_file_path(tmp_path, PARAMS), PARAMS, *linear_push(n=500))
     data = path.read_bytes()
     path.write_bytes(data[: len(data) // 2])
-    for read in (mit_push.read_raw_push, mit_push.load_push):
+    for read in (files.read_raw_push, files.load_push):
         with pytest.raises(PushFileError, match=str(path).replace(".", r"\.")) as error:
             read(path)
         assert error.value.reason == "unreadable file" and error.value.path == path
@@ -194,7 +219,7 @@ def test_truncated_file_raises_naming_it(tmp_path):
 def test_malformed_files_raise_with_reason(tmp_path, datasets, reason):
     path = write_file(tmp_path / "bad.h5", **datasets)
     with pytest.raises(PushFileError, match=f"{path}: {reason}") as error:
-        mit_push.read_raw_push(path)
+        files.read_raw_push(path)
     assert error.value.reason == reason
 
 
@@ -203,16 +228,16 @@ def test_nan_and_single_time_stamp_files_raise(tmp_path):
     nan_obj = obj.copy()
     nan_obj[3, 2] = np.nan
     with pytest.raises(PushFileError, match="non-finite values"):
-        mit_push.read_raw_push(write_file(tmp_path / "nan.h5", tip_pose=tip, object_pose=nan_obj, ft_wrench=wrench))
+        files.read_raw_push(write_file(tmp_path / "nan.h5", tip_pose=tip, object_pose=nan_obj, ft_wrench=wrench))
     constant_time = wrench.copy()
     constant_time[:, 0] = 0.5
     with pytest.raises(PushFileError, match="too few time stamps"):
-        mit_push.load_push(write_file(tmp_path / "t.h5", tip_pose=tip, object_pose=obj, ft_wrench=constant_time))
+        files.load_push(write_file(tmp_path / "t.h5", tip_pose=tip, object_pose=obj, ft_wrench=constant_time))
 
 
 def test_missing_file_is_not_a_data_error(tmp_path):
     with pytest.raises(FileNotFoundError):
-        mit_push.read_raw_push(tmp_path / "absent.h5")
+        files.read_raw_push(tmp_path / "absent.h5")
 
 
 # Cleaning and resampling.
@@ -227,9 +252,9 @@ def test_cleaning_drops_duplicates_sorts_and_unwraps_yaw(tmp_path):
     stored_object = np.insert(stored_object, 4, [t[2], 9.0, 9.0, 9.0], axis=0)
     tip, _, wrench = linear_push(n=6)
     stored_wrench = np.concatenate([wrench[3:], wrench[:3], wrench[:1] + [0, 5.0, 5.0, 5.0]])  # late duplicate
-    path = mit_push.write_push(tmp_path / "x.h5", None, tip, stored_object, stored_wrench)
+    path = files.write_push(tmp_path / "x.h5", None, tip, stored_object, stored_wrench)
 
-    push = mit_push.load_push(path, frequency=250.0)
+    push = files.load_push(path, frequency=250.0)
     np.testing.assert_allclose(push.time, t, atol=1e-15)
     np.testing.assert_allclose(push.object[:, :2], clean_object[:, 1:3], atol=1e-12)
     np.testing.assert_allclose(push.object[:, 2], [3.0, 3.1, 2 * np.pi - 3.1, 2 * np.pi - 3.0, 2 * np.pi - 2.9,
@@ -237,15 +262,15 @@ def test_cleaning_drops_duplicates_sorts_and_unwraps_yaw(tmp_path):
     np.testing.assert_allclose(push.wrench, wrench[:, 1:], atol=1e-12)
     np.testing.assert_allclose(push.tip, tip[:, 1:], atol=1e-12)
     # The raw reader leaves the stored rows alone.
-    np.testing.assert_array_equal(mit_push.read_raw_push(path).object_pose, stored_object)
+    np.testing.assert_array_equal(files.read_raw_push(path).object_pose, stored_object)
 
 
 def test_resampling_a_linear_signal_on_the_overlap(tmp_path):
     tip, _, _ = linear_push(n=100, rate=240.0, offset=0.013)  # 0.013 .. 0.4255 s
     _, obj, _ = linear_push(n=130, rate=260.0, offset=0.0)  # 0 .. 0.4962 s
     _, _, wrench = linear_push(n=90, rate=200.0, offset=0.02)  # 0.02 .. 0.465 s
-    path = mit_push.write_push(tmp_path / "x.h5", None, tip, obj, wrench)
-    push = mit_push.load_push(path, frequency=100.0)
+    path = files.write_push(tmp_path / "x.h5", None, tip, obj, wrench)
+    push = files.load_push(path, frequency=100.0)
     start, end = 0.02, 0.013 + 99 / 240.0
     assert push.time.shape == (math.floor((end - start) * 100.0) + 1,)
     np.testing.assert_allclose(push.time, np.arange(push.time.size) / 100.0)
@@ -260,11 +285,11 @@ def test_resampling_a_linear_signal_on_the_overlap(tmp_path):
 def test_streams_without_overlap_raise(tmp_path):
     tip, obj, wrench = linear_push(n=10)
     late_wrench = wrench + [1.0, 0, 0, 0]
-    path = mit_push.write_push(tmp_path / "x.h5", None, tip, obj, late_wrench)
+    path = files.write_push(tmp_path / "x.h5", None, tip, obj, late_wrench)
     with pytest.raises(PushFileError, match="no time overlap"):
-        mit_push.load_push(path)
+        files.load_push(path)
     with pytest.raises(ValueError, match="frequency"):
-        mit_push.load_push(path, frequency=0.0)
+        files.load_push(path, frequency=0.0)
 
 
 def test_zero_initial_pose(tmp_path):
@@ -275,15 +300,15 @@ def test_zero_initial_pose(tmp_path):
     obj = np.column_stack([t, np.full(n, x0), y0 + 0.02 * t, yaw0 + 0.1 * t])
     tip = np.column_stack([t, np.full(n, x0), y0 - 0.05 + 0.02 * t, np.full(n, yaw0)])
     wrench = np.column_stack([t, np.zeros(n), np.full(n, 2.0), np.full(n, 0.03)])  # pushing along world +y
-    path = mit_push.write_push(tmp_path / "x.h5", None, tip, obj, wrench)
+    path = files.write_push(tmp_path / "x.h5", None, tip, obj, wrench)
 
-    push = mit_push.load_push(path, zero_initial_pose=True)
+    push = files.load_push(path, zero_initial_pose=True)
     np.testing.assert_allclose(push.object[0], [0, 0, 0], atol=1e-15)
     np.testing.assert_allclose(push.object, np.column_stack([0.02 * t, 0 * t, 0.1 * t]), atol=1e-15)
     np.testing.assert_allclose(push.tip, np.column_stack([0.02 * t - 0.05, 0 * t, 0 * t]), atol=1e-15)
     np.testing.assert_allclose(push.wrench, np.column_stack([np.full(n, 2.0), 0 * t, np.full(n, 0.03)]), atol=1e-15)
     # The world-frame version is untouched, and distances are preserved.
-    world = mit_push.load_push(path)
+    world = files.load_push(path)
     np.testing.assert_allclose(world.object, obj[:, 1:], atol=1e-15)
     np.testing.assert_allclose(np.linalg.norm(push.tip[:, :2] - push.object[:, :2], axis=-1),
                                np.linalg.norm(world.tip[:, :2] - world.object[:, :2], axis=-1), atol=1e-15)
@@ -299,18 +324,18 @@ def dataset_root(tmp_path):
         ("abs", "rect1", 20, 1500),
     ]:
         params = PushParams(surface, shape, acceleration, velocity, 0, 0.5, 0.0)
-        mit_push.write_push(mit_push.push_file_path(tmp_path, params), params, tip, obj, wrench)
-    truncated = mit_push.write_push(mit_push.push_file_path(tmp_path, PARAMS), PARAMS, tip, obj, wrench)
+        files.write_push(files.push_file_path(tmp_path, params), params, tip, obj, wrench)
+    truncated = files.write_push(files.push_file_path(tmp_path, PARAMS), PARAMS, tip, obj, wrench)
     truncated.write_bytes(truncated.read_bytes()[:300])
     missing = PushParams("abs", "rect1", 0, 20, 1, 0.5, 0.0)
-    write_file(mit_push.push_file_path(tmp_path, missing), tip_pose=tip, object_pose=obj)
+    write_file(files.push_file_path(tmp_path, missing), tip_pose=tip, object_pose=obj)
     (tmp_path / "abs" / "rect1" / "notes.h5").write_bytes(b"not a push")
     (tmp_path / "abs" / "rect1" / "README.txt").write_text("ignored")
     return tmp_path
 
 
 def test_iter_pushes_yields_sorted_and_reports_skipped(dataset_root, caplog):
-    pushes = mit_push.iter_pushes(dataset_root)
+    pushes = files.iter_pushes(dataset_root)
     with caplog.at_level(logging.INFO):
         loaded = list(pushes)
     names = [push.path.relative_to(dataset_root).as_posix() for push in loaded]
@@ -330,7 +355,7 @@ def test_iter_pushes_yields_sorted_and_reports_skipped(dataset_root, caplog):
 def test_iter_pushes_filters(dataset_root):
     def kept(**filters):
         return sorted((p.params.surface, p.params.shape, p.params.velocity, p.params.acceleration)
-                      for p in mit_push.iter_pushes(dataset_root, **filters))
+                      for p in files.iter_pushes(dataset_root, **filters))
 
     assert kept(objects={"tri1"}) == [("abs", "tri1", 20.0, 0.0)]
     assert kept(surfaces=["delrin"]) == [("delrin", "rect1", 20.0, 0.0)]
@@ -338,7 +363,7 @@ def test_iter_pushes_filters(dataset_root):
     assert kept(accelerations=[1500]) == [("abs", "rect1", 20.0, 1500.0)]
     assert kept(velocities=[20], accelerations=[0], surfaces={"abs"}) == [
         ("abs", "rect1", 20.0, 0.0), ("abs", "tri1", 20.0, 0.0)]
-    pushes = mit_push.iter_pushes(dataset_root, objects={"tri1"}, zero_initial_pose=True, frequency=100.0)
+    pushes = files.iter_pushes(dataset_root, objects={"tri1"}, zero_initial_pose=True, frequency=100.0)
     (push,) = list(pushes)
     assert pushes.n_filtered == 6 and pushes.n_skipped == 1  # only the unparseable name is never filtered
     np.testing.assert_allclose(push.time[1], 0.01)
@@ -346,8 +371,8 @@ def test_iter_pushes_filters(dataset_root):
 
 def test_iter_pushes_rejects_bad_arguments(dataset_root):
     with pytest.raises(ValueError, match="not a directory"):
-        mit_push.iter_pushes(dataset_root / "absent")
+        files.iter_pushes(dataset_root / "absent")
     with pytest.raises(ValueError, match="objects must be a collection"):
-        mit_push.iter_pushes(dataset_root, objects="rect1")
+        files.iter_pushes(dataset_root, objects="rect1")
     with pytest.raises(ValueError, match="frequency"):
-        mit_push.iter_pushes(dataset_root, frequency=-1.0)
+        files.iter_pushes(dataset_root, frequency=-1.0)

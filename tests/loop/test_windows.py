@@ -5,9 +5,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from pushjax.data.mit_push import iter_pushes, load_push
 from pushjax.geometry import get_object
-from pushjax.loop.examples import VARIABLES, build_examples, split_by_sequence
+from pushjax.loop.windows import VARIABLES, build_examples, split_by_sequence
+from pushjax.mit.files import iter_pushes, load_push
 from pushjax.physics.effects import PushInputs
 from pushjax.sim.dataset import record_pushes
 from pushjax.sim.effects import Effects

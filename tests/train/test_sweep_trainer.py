@@ -1,20 +1,16 @@
 import csv
 import dataclasses
+import warnings
 
 import jax
 import numpy as np
 import pytest
 
+from pushjax import train
 from pushjax.models import VARIANTS
-from pushjax.train import evaluate, train
-from pushjax.train.configs import get_config
+from pushjax.train import evaluate
+from tests.tiny_configs import TINY_SMOKE as SMOKE
 
-SMOKE = get_config("smoke")
-
-
-@pytest.fixture(scope="module")
-def examples(smoke):
-    return smoke["train"]
 
 
 def _config(variant="hybrid", view="top_down", **changes):
@@ -23,24 +19,6 @@ def _config(variant="hybrid", view="top_down", **changes):
 
 def _params(result):
     return jax.tree.map(np.asarray, result.state.params)
-
-
-def test_batch_order_walks_through_permuted_epochs():
-    spec = train.ModelSpec("m", np.arange(100, 110), seed=3)
-    batches = np.concatenate([train.batch_indices(spec, step, 4) for step in range(5)])
-    assert sorted(batches[:10]) == list(range(100, 110))  # epoch 0
-    assert sorted(batches[10:20]) == list(range(100, 110))  # epoch 1
-    assert not np.array_equal(batches[:10], batches[10:20])
-    np.testing.assert_array_equal(train.batch_indices(spec, 3, 4), batches[12:16])
-
-
-def test_subset_specs():
-    specs = train.subset_specs(50, sizes=[10, 20], seeds=[0, 1])
-    assert [len(spec.train_indices) for spec in specs] == [10, 10, 20, 20]
-    assert not np.array_equal(specs[0].train_indices, specs[1].train_indices)
-    assert all(len(np.unique(spec.train_indices)) == len(spec.train_indices) for spec in specs)
-    with pytest.raises(ValueError, match="sizes"):
-        train.subset_specs(50, sizes=[51], seeds=[0])
 
 
 @pytest.mark.parametrize(
@@ -64,6 +42,7 @@ def test_every_variant_learns_without_nan(variant, view, smoke, smoke_viewpoint,
     assert [int(row["step"]) for row in rows] == list(range(20, 201, 20))
     metrics = evaluate.evaluate_sweep(result, splits["test"], batch_size=64)[0]
     assert np.isfinite(metrics["trans_percent"]) and np.isfinite(metrics["rot_percent"])
+    np.testing.assert_array_equal(result.steps_trained, [200])
 
 
 def test_vmapped_sweep_equals_separate_runs(examples):
@@ -86,6 +65,9 @@ def test_vmapped_sweep_equals_separate_runs(examples):
     # The models differ, so the comparison is not trivially true.
     kernel = jax.tree.leaves(_params(vmapped))[0]
     assert not np.allclose(kernel[0], kernel[1])
+    for result in (separate, vmapped, unrolled):
+        np.testing.assert_array_equal(result.steps_trained, [12, 12, 12])
+        assert result.final_metrics["loss"].shape == (3,)
 
 
 class Killed(Exception):
@@ -119,19 +101,52 @@ def test_killed_training_resumes_to_the_uninterrupted_parameters(mode, examples,
     with (tmp_path / "killed" / "metrics.csv").open() as file:
         steps = [int(row["step"]) for row in csv.DictReader(file)]
     assert steps == [step for step in range(5, 31, 5) for _ in specs]
+    np.testing.assert_array_equal(resumed.steps_trained, [30, 30])
 
     with pytest.raises(ValueError, match="different models"):
         train.sweep(config, examples, train.subset_specs(256, [30], [5]), tmp_path / "killed", progress=False)
 
 
-def test_error_metrics_against_the_zero_baseline(examples):
-    zero = {"motion": np.zeros_like(examples["motion"])}
-    metrics = evaluate.error_metrics(zero, examples)
-    assert metrics["trans_percent"] == pytest.approx(100.0)
-    assert metrics["rot_percent"] == pytest.approx(100.0)
-    perfect = {name: examples[name] for name in ("motion", "object_pos", "contact", "normal")}
-    perfect["s"] = examples["contact_flag"]
-    metrics = evaluate.error_metrics(perfect, examples)
-    for name in ("trans_percent", "rot_percent", "pos_mm", "contact_mm", "normal_deg", "s"):
-        assert metrics[name] == pytest.approx(0.0, abs=1e-3), name
-    assert metrics["push_velocity_deg"] < 0.1
+def test_resuming_a_finished_sweep_reports_the_restored_steps(examples, tmp_path):
+    config = _config("hybrid", num_steps=6, checkpoint_every=3, log_every=3)
+    specs = train.subset_specs(256, [30], [1, 2])
+    finished = train.sweep(config, examples, specs, tmp_path, mode="sequential", progress=False)
+    np.testing.assert_array_equal(finished.steps_trained, [6, 6])
+    # Rerun, or run with fewer steps than the checkpoint holds: nothing to train, and the restored
+    # state comes back as it is, with its own step count.
+    for num_steps in (6, 4):
+        steps = []
+        again = train.sweep(dataclasses.replace(config, num_steps=num_steps), examples, specs, tmp_path,
+                            mode="vmap", progress=False, step_callback=lambda step, metrics: steps.append(step))
+        assert steps == [] and again.final_metrics == {}
+        np.testing.assert_array_equal(again.steps_trained, [6, 6])
+        jax.tree.map(np.testing.assert_array_equal, _params(again), _params(finished))
+
+
+def test_resuming_past_the_requested_steps_warns(examples, tmp_path):
+    config = _config("hybrid", num_steps=6, checkpoint_every=3, log_every=3)
+    specs = train.subset_specs(256, [30], [1])
+    train.sweep(config, examples, specs, tmp_path, mode="sequential", progress=False)
+    with pytest.warns(UserWarning) as caught:
+        fewer = train.sweep(dataclasses.replace(config, num_steps=4), examples, specs, tmp_path, mode="sequential",
+                            progress=False)
+    assert len(caught) == 1
+    message = str(caught[0].message)
+    assert str(tmp_path) in message and "step 6" in message and "num_steps 4" in message, message
+    np.testing.assert_array_equal(fewer.steps_trained, [6])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        train.sweep(config, examples, specs, tmp_path, mode="sequential", progress=False)  # as requested
+
+
+def test_sweep_rejects_bad_arguments(examples):
+    specs = train.subset_specs(256, [30], [0])
+    assert train.SWEEP_MODES == ("vmap", "unroll", "sequential")
+    with pytest.raises(ValueError, match="mode"):
+        train.sweep(SMOKE, examples, specs, mode="pmap", progress=False)
+    with pytest.raises(ValueError, match="specs"):
+        train.sweep(SMOKE, examples, [], progress=False)
+    with pytest.raises(ValueError, match="outside"):
+        train.sweep(SMOKE, examples, [train.ModelSpec("far", np.array([10**6]), seed=0)], progress=False)
+    with pytest.raises(ValueError, match="error variant"):
+        train.sweep(SMOKE, examples, [train.ModelSpec("e", np.arange(4), seed=0, variant="error")], progress=False)

@@ -16,7 +16,7 @@ import os
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-from pushjax.experiments import tables
+from pushjax.paper import tables
 
 Results = Mapping[str, Mapping]
 """binary name (``data_efficiency``, ``new_pushes``, ``velocities``, ``error_variants``, ...) -> results."""

@@ -1,4 +1,4 @@
-"""Markdown tables laid out like the paper's, from the ``results`` of `pushjax.experiments.runner.run`.
+"""Markdown tables laid out like the paper's, from the ``results`` of `pushjax.paper.runner.run`.
 
 Cells are the mean over seeds; the standard error of that mean combines the per-seed standard errors
 (``sqrt(sum se_i^2) / n``). Translation and rotation errors are percentages of the ``zero`` baseline's.

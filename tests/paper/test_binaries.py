@@ -92,7 +92,7 @@ def test_bad_flags_are_usage_errors(tmp_path, arguments, message):
 
 
 def test_clipped_sizes_warn():
-    from pushjax.experiments import runner
+    from pushjax.paper import runner
 
     with pytest.warns(UserWarning, match=r"exceed the 100 examples of training split 'train'; clipped to 100"):
         assert runner.clip_sizes([50, 200, 300], 100) == (50, 100)
@@ -101,6 +101,28 @@ def test_clipped_sizes_warn():
 def test_missing_workdir_is_a_usage_error():
     with pytest.raises(app.UsageError, match="workdir"):
         run_binary("data_efficiency", "--scale=smoke")
+
+
+@pytest.mark.parametrize("binary", ["data_efficiency", "train"])
+def test_nobuild_names_the_missing_dataset_where_it_looked_and_build(tmp_path, binary):
+    message = (r"^--build: dataset push_effects/data_efficiency_smoke is not built \(looked in "
+               f"{tmp_path}/push_effects/data_efficiency_smoke/1.0.0" r"\) and --nobuild forbids building it; "
+               "--build builds it there$")
+    with pytest.raises(app.UsageError, match=message):
+        run_binary(binary, "--scale=smoke", f"--workdir={tmp_path / 'work'}", f"--data_dir={tmp_path}", "--nobuild")
+    assert not (tmp_path / "push_effects").exists()
+
+
+@pytest.mark.parametrize("binary, last_line", [
+    ("data_efficiency", "wrote results.json, results.md and 1 figure (fig5_data_efficiency.png) to {workdir}"),
+    ("train", "wrote results.json and 0 sweep folders (checkpoints, metrics.csv) to {workdir}"),
+])
+def test_binaries_end_with_what_they_wrote_where(smoke_data, tmp_path, capsys, binary, last_line):
+    workdir = tmp_path / "work"
+    run_binary(binary, "--scale=smoke", f"--data_dir={smoke_data('data_efficiency')}", f"--workdir={workdir}",
+               "--variants=zero,physics")
+    assert capsys.readouterr().out.splitlines()[-1] == last_line.format(workdir=workdir)
+    assert (workdir / "results.json").is_file()
 
 
 def test_visualize(smoke_results):

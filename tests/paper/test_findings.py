@@ -5,8 +5,8 @@ import json
 import pytest
 from absl import app
 
-from pushjax.experiments import findings
-from tests.experiments.conftest import run_binary
+from pushjax.paper import findings
+from tests.paper.conftest import run_binary
 
 
 def _row(model, score, se=0.5, *, size=None, test_split="test", train_split="train", l_scale=1.0):
@@ -81,7 +81,8 @@ def test_findings_binary_on_smoke_results(smoke_results, tmp_path, capsys):
     workdirs = [smoke_results("data_efficiency"), smoke_results("error_variants")]
     run_binary("findings", f"--workdirs={','.join(map(str, workdirs))}", f"--output={output}")
     table = output.read_text()
-    assert capsys.readouterr().out.strip().endswith(table.strip())
+    printed = capsys.readouterr().out.strip()
+    assert printed.endswith(f"{table.strip()}\nwrote the table to {output}")
     assert table.count("\n| ") == len(findings.CHECKS)
     assert "| With a wrong l, error compensates better than hybrid. | error_variants |" in table
 

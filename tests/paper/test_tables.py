@@ -1,10 +1,10 @@
-"""Seed aggregation and table layout of pushjax.experiments.tables, on hand-made rows."""
+"""Seed aggregation and table layout of pushjax.paper.tables, on hand-made rows."""
 
 import math
 
 import pytest
 
-from pushjax.experiments import tables
+from pushjax.paper import tables
 
 
 def _row(model, size, seed, trans, trans_se):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pushjax import planar
 from pushjax.geometry.objects import PUSHER_RADIUS, all_objects, limit_surface_ratio
 from pushjax.physics.rollout import rollout
 
@@ -28,8 +29,7 @@ def analytical_push_table(mu: float = 0.25, angle_deg: float = 20.0, point: floa
     angle = np.deg2rad(angle_deg)
     for obj in all_objects():
         surface_point, normal = obj.side_point(0, point)
-        rotation = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
-        direction = rotation @ normal
+        direction = planar.rotation_matrix(angle) @ normal
         pusher_start = surface_point - direction * (PUSHER_RADIUS / max(direction @ normal, 1e-6) + 1e-3)
         poses = rollout(obj, np.zeros(3), pusher_start, PUSH_DISTANCE * direction, mu, steps=steps)
         dx, dy, dtheta = poses[-1] - poses[0]

@@ -1,6 +1,6 @@
-"""Prediction examples from measured pushes: horizon windows, contact annotation, split by push.
+"""The closed loop's prediction windows of measured pushes: horizon windows, contact annotation, split by push.
 
-Only what real MIT files hold is used: the three streams (resampled by :mod:`pushjax.data.mit_push`)
+Only what real MIT files hold is used: the three streams (resampled by :mod:`pushjax.mit.files`)
 and the file-name fields; file attributes (e.g. declared simulation effects) are never read.
 
 A window starts at ``t0`` while the pusher moves (every ``stride`` s from its first motion) and ends
@@ -22,8 +22,9 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from pushjax.data.mit_push import Push
+from pushjax import planar
 from pushjax.geometry import OBJECT_NAMES, PUSHER_RADIUS, annotate, get_object, limit_surface_ratio
+from pushjax.mit.files import Push
 from pushjax.physics.effects import PushInputs
 
 NOMINAL_PUSHER_FRICTION = 0.25
@@ -155,7 +156,7 @@ def build_examples(
     """Windows of every push, annotated for the pushing model.
 
     Args:
-      pushes: cleaned pushes (e.g. :func:`pushjax.data.mit_push.iter_pushes`), each with file-name
+      pushes: cleaned pushes (e.g. :func:`pushjax.mit.files.iter_pushes`), each with file-name
         parameters.
       horizon: window length, s (> 0).
       stride: time between window starts, s; default ``horizon / 2``.
@@ -239,7 +240,7 @@ def _annotate_object(name: str, rows: list[dict], pusher_friction: float) -> dic
             array[found] = np.asarray(values)[np.asarray(ahead.touches)]
     annotated = np.any(normal != 0, axis=1)
     gap = np.where(annotated, np.sum((contact_world - tip0) * normal, axis=1) - PUSHER_RADIUS, 0.0)
-    com0, com1 = _centre_of_mass(obj.centroid, pose0), _centre_of_mass(obj.centroid, pose1)
+    com0, com1 = planar.centre_of_mass(obj.centroid, pose0), planar.centre_of_mass(obj.centroid, pose1)
     count = len(pose0)
     yaw = pose0[:, 2]
     variables = {
@@ -263,12 +264,6 @@ def _annotate_object(name: str, rows: list[dict], pusher_friction: float) -> dic
         target=np.column_stack([com1 - com0, pose1[:, 2] - pose0[:, 2]]),
         sequence=data["sequence"], push=data["push"], variables=variables,
     )
-
-
-def _centre_of_mass(centroid: np.ndarray, poses: np.ndarray) -> np.ndarray:
-    """[N, 2] world position of the centroid for [N, 3] tracked-frame poses."""
-    cos, sin = np.cos(poses[:, 2]), np.sin(poses[:, 2])
-    return poses[:, :2] + np.stack([cos * centroid[0] - sin * centroid[1], sin * centroid[0] + cos * centroid[1]], 1)
 
 
 def split_by_sequence(examples: Examples, heldout_fraction: float = 0.3, seed: int = 0) -> tuple[Examples, Examples]:

@@ -1,8 +1,7 @@
-"""Matplotlib figures (PNG) of the ``results`` of `pushjax.experiments.runner.run`, like the paper's."""
+"""Matplotlib figures (PNG) of the ``results`` of `pushjax.paper.runner.run`, like the paper's."""
 
 from __future__ import annotations
 
-import itertools
 import os
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -13,9 +12,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from pushjax.experiments import tables  # noqa: E402
+from pushjax.paper import tables  # noqa: E402
 
 PANELS = (("trans_percent", "translation error [% of zero]"), ("rot_percent", "rotation error [% of zero]"))
+MODEL_ORDER = ("zero", "physics", "neural", "neural_dyn", "hybrid", "simple", "error", "error_grad", "error_norm")
+MODEL_COLOURS = dict(zip(MODEL_ORDER, plt.get_cmap("tab10").colors))
+"""One colour per model, the same in every figure."""
+_LINE_STYLES = ("-", "--", ":", "-.")
+_MARKERS = ("o", "s", "^", "D", "v")
+_HATCHES = ("", "//", "..", "xx", "\\\\")
 
 
 def _series(rows: Sequence[Mapping], series_keys: Sequence[str]) -> dict[str, list[Mapping]]:
@@ -26,45 +31,79 @@ def _series(rows: Sequence[Mapping], series_keys: Sequence[str]) -> dict[str, li
     return series
 
 
+def _variant_index(series: Mapping[str, list[Mapping]]) -> dict[str, int]:
+    """series label -> index of its non-model keys (e.g. its training split) among the series of its model."""
+    seen: dict[str, int] = {}
+    index = {}
+    for label, members in series.items():
+        model = members[0]["model"]
+        index[label] = seen.get(model, 0)
+        seen[model] = index[label] + 1
+    return index
+
+
+def _colour(model: str):
+    return MODEL_COLOURS.get(model, "0.3")
+
+
 def _value(row, metric):
     value = row.get(metric)
     return np.nan if value is None else value
+
+
+def _finish(figure, axes, path) -> Path:
+    """One legend for all panels, outside the data, and the PNG."""
+    handles, labels = axes[0].get_legend_handles_labels()
+    figure.tight_layout()
+    figure.legend(handles, labels, loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
+    figure.savefig(path, dpi=100, bbox_inches="tight")
+    plt.close(figure)
+    return Path(path)
 
 
 def line_figure(rows: Sequence[Mapping], x: Callable[[Mapping], float], x_label: str,
                 series_keys: Sequence[str], path: str | os.PathLike, log_x: bool = False) -> Path:
     """Trans. and rot. errors (± s.e.) against ``x(row)``, a line per distinct `series_keys`.
 
-    Rows where ``x(row)`` is None (baselines without a training size) are drawn as horizontal dashed lines.
+    The colour says the model (`MODEL_COLOURS`), the line style and marker the other series keys. Rows where
+    ``x(row)`` is None (baselines without a training size) are drawn as horizontal lines.
     """
+    series = _series(rows, series_keys)
+    variant = _variant_index(series)
     figure, axes = plt.subplots(1, len(PANELS), figsize=(11, 4))
     for axis, (metric, label) in zip(axes, PANELS):
-        baseline_styles = itertools.cycle(("--", ":", "-."))
-        for name, members in _series(rows, series_keys).items():
+        xs_seen = set()
+        for name, members in series.items():
+            colour, k = _colour(members[0]["model"]), variant[name]
+            style = _LINE_STYLES[k % len(_LINE_STYLES)]
             points = sorted((x(row), _value(row, metric), _value(row, f"{metric}_se")) for row in members
                             if x(row) is not None)
             if points:
                 xs, ys, ses = map(np.asarray, zip(*points))
-                axis.errorbar(xs, ys, yerr=np.nan_to_num(ses), marker="o", capsize=3, label=name)
+                xs_seen.update(xs.tolist())
+                axis.errorbar(xs, ys, yerr=np.nan_to_num(ses), marker=_MARKERS[k % len(_MARKERS)], linestyle=style,
+                              color=colour, capsize=3, label=name)
             else:
-                axis.axhline(_value(members[0], metric), linestyle=next(baseline_styles), color="k", label=name)
+                axis.axhline(_value(members[0], metric), linestyle="--", color=colour, linewidth=1.2, label=name)
         axis.set_xlabel(x_label)
         axis.set_ylabel(label)
         if log_x:
             axis.set_xscale("log")
+            axis.set_xticks(sorted(xs_seen), [f"{value:,.0f}" for value in sorted(xs_seen)])
+            axis.minorticks_off()
         axis.grid(alpha=0.3)
-    axes[0].legend(fontsize="small")
-    figure.tight_layout()
-    figure.savefig(path, dpi=100)
-    plt.close(figure)
-    return Path(path)
+    return _finish(figure, axes, path)
 
 
 def bar_figure(rows: Sequence[Mapping], group_key: str, series_keys: Sequence[str],
                path: str | os.PathLike) -> Path:
-    """Grouped bars of trans. and rot. errors (± s.e.): a group per value of `group_key`, a bar per series."""
+    """Grouped bars of trans. and rot. errors (± s.e.): a group per value of `group_key`, a bar per series.
+
+    The colour says the model (`MODEL_COLOURS`), the hatching the other series keys.
+    """
     groups = sorted({row[group_key] for row in rows}, key=tables._sort_key)
     series = _series(rows, series_keys)
+    variant = _variant_index(series)
     width = 0.8 / max(len(series), 1)
     figure, axes = plt.subplots(1, len(PANELS), figsize=(11, 4))
     for axis, (metric, label) in zip(axes, PANELS):
@@ -72,14 +111,14 @@ def bar_figure(rows: Sequence[Mapping], group_key: str, series_keys: Sequence[st
             by_group = {row[group_key]: row for row in members}
             values = [_value(by_group[g], metric) if g in by_group else np.nan for g in groups]
             errors = [_value(by_group[g], f"{metric}_se") if g in by_group else np.nan for g in groups]
-            axis.bar(np.arange(len(groups)) + k * width, values, width, yerr=np.nan_to_num(errors), label=name)
+            axis.bar(np.arange(len(groups)) + k * width, values, width, yerr=np.nan_to_num(errors), label=name,
+                     color=_colour(members[0]["model"]), hatch=_HATCHES[variant[name] % len(_HATCHES)],
+                     edgecolor="white", linewidth=0.5)
         axis.set_xticks(np.arange(len(groups)) + 0.4 - width / 2, [str(g) for g in groups], rotation=30)
+        axis.set_xlabel(group_key.replace("_", " "))
         axis.set_ylabel(label)
-    axes[0].legend(fontsize="small")
-    figure.tight_layout()
-    figure.savefig(path, dpi=100)
-    plt.close(figure)
-    return Path(path)
+        axis.grid(alpha=0.3, axis="y")
+    return _finish(figure, axes, path)
 
 
 def _velocity(row):

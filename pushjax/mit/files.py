@@ -1,4 +1,4 @@
-"""The raw MIT Push Dataset file layout (Yu et al., IROS 2016): writer, reader and cleaning.
+"""The raw MIT Push Dataset file layout (Yu et al., IROS 2016): file names, writer, reader, cleaning, iteration.
 
 Layout: ``<root>/<surface>/<object>/`` holds one HDF5 file per push, named
 
@@ -27,6 +27,7 @@ import json
 import math
 import os
 import re
+import secrets
 from collections.abc import Collection, Iterator, Mapping
 from pathlib import Path
 from typing import Any
@@ -34,6 +35,8 @@ from typing import Any
 import h5py
 import numpy as np
 from absl import logging
+
+from pushjax import planar
 
 POSE_DATASETS = ("tip_pose", "object_pose")
 WRENCH_DATASET = "ft_wrench"
@@ -272,7 +275,10 @@ def write_push(
 ) -> Path:
     """Writes one push file in the dataset's layout, deterministically (same inputs, same bytes).
 
-    The file is written next to ``path`` and then renamed, so an interrupted write leaves no truncated ``.h5``.
+    The file is written to a temporary file next to ``path``, named uniquely per call
+    (``.<name>.<pid>.<random hex>.partial``), and then renamed onto ``path``: an interrupted write leaves no
+    truncated ``.h5``, and concurrent writers of the same file never collide (the last rename wins; with the
+    same inputs they write the same bytes). A writer killed outright leaves its hidden ``.partial`` file behind.
     Parent directories are created.
 
     Args:
@@ -300,9 +306,11 @@ def write_push(
     checked_attributes = {name: _validated_attribute(name, attributes[name]) for name in sorted(attributes)}
 
     path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(path.name + ".partial")
+    # A name of this writer's own, so concurrent writers of one file never share (or truncate) a temporary file;
+    # "w-" refuses to open a file that already exists. Not ending in .h5, so readers never list it.
+    partial = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(8)}.partial")
     try:
-        with h5py.File(partial, "w", libver=_LIBVER) as file:
+        with h5py.File(partial, "w-", libver=_LIBVER) as file:
             for name, stream in streams.items():
                 file.create_dataset(name, data=stream, dtype="<f8", track_times=False)
             for name, value in checked_attributes.items():
@@ -391,11 +399,6 @@ def _clean_stream(stream: np.ndarray, unwrap_yaw: bool) -> np.ndarray:
     return cleaned
 
 
-def _rotation(yaw: float) -> np.ndarray:
-    cos, sin = math.cos(yaw), math.sin(yaw)
-    return np.array([[cos, -sin], [sin, cos]])
-
-
 def _check_frequency(frequency: float) -> None:
     if not (isinstance(frequency, (int, float, np.integer, np.floating)) and math.isfinite(frequency)
             and frequency > 0):
@@ -440,7 +443,7 @@ def clean_push(raw: RawPush, frequency: float = DEFAULT_FREQUENCY, zero_initial_
     )
     if zero_initial_pose:
         origin, yaw0 = object_pose[0, :2].copy(), object_pose[0, 2]
-        to_object_frame = _rotation(-yaw0)
+        to_object_frame = planar.rotation_matrix(-yaw0)
         for pose in (tip, object_pose):
             pose[:, :2] = (pose[:, :2] - origin) @ to_object_frame.T
             pose[:, 2] -= yaw0

@@ -1,0 +1,79 @@
+"""Command-line flags shared by the experiment binaries under ``experiments/``, and their ``main``.
+
+Importing this module defines the flags (absl's global ``FLAGS``); ``experiments/train.py`` shares them.
+`spec_from_flags` is the one place where flags become an `ExperimentSpec`; each binary is
+``main(argv) -> cli.main(<name>, argv)``, which runs the spec (`run_spec`: `pushjax.paper.runner.run`), writes its
+tables and figures and ends with one line saying what it wrote where. A bad flag is an ``app.UsageError`` naming
+the flag, raised before any dataset is built or model trained.
+"""
+
+from __future__ import annotations
+
+import warnings
+from absl import app, flags, logging
+
+from pushjax.data import configs as data_configs
+from pushjax.paper import figures, paths, runner, spec as spec_lib, tables, visualize
+from pushjax.train import SWEEP_MODES
+
+SCALE = flags.DEFINE_enum("scale", data_configs.DEFAULT_SCALE, data_configs.SCALES, "Dataset and training scale.")
+WORKDIR = flags.DEFINE_string("workdir", None, "Output folder: checkpoints, results.json, results.md, figures.")
+SIZES = flags.DEFINE_list("sizes", [], "Training-set sizes (default: the experiment's; larger ones are clipped).")
+SEEDS = flags.DEFINE_list("seeds", ["0"], "Subset and initialisation seeds.")
+NUM_STEPS = flags.DEFINE_integer("num_steps", None, "Override the scale's number of training steps.")
+DATA_DIR = flags.DEFINE_string("data_dir", None, "TFDS data directory, must exist (default: TFDS's).")
+BUILD = flags.DEFINE_bool("build", True, "Build the dataset when it is missing.")
+WORKERS = flags.DEFINE_integer("workers", None, "Dataset build processes (default: the builder's).")
+MODE = flags.DEFINE_enum("mode", None, SWEEP_MODES, "Sweep batching (default: sequential on CPU, else vmap).")
+VARIANTS_FLAG = flags.DEFINE_list("variants", [], "Models to train and baselines (default: the experiment's).")
+
+
+def spec_from_flags(setup: spec_lib.Setup) -> spec_lib.ExperimentSpec:
+    """The `ExperimentSpec` of `setup` with the parsed flags; a bad flag raises ``app.UsageError``."""
+    if WORKDIR.value is None:
+        raise app.UsageError("--workdir is required")
+    try:
+        paths.check_writable_folder(WORKDIR.value)
+    except ValueError as error:
+        raise app.UsageError(f"--workdir={WORKDIR.value}: {error}") from error
+    try:
+        return spec_lib.make_spec(
+            setup, SCALE.value, models=VARIANTS_FLAG.value, sizes=SIZES.value, seeds=SEEDS.value,
+            num_steps=NUM_STEPS.value, data_dir=DATA_DIR.value, build=BUILD.value, workers=WORKERS.value,
+            mode=MODE.value,
+        )
+    except ValueError as error:
+        raise app.UsageError(f"--{error}") from error
+
+
+def run_spec(spec: spec_lib.ExperimentSpec) -> runner.RunOutcome:
+    """`runner.run` of `spec` in ``--workdir``, its warnings (e.g. clipped sizes) logged once each.
+
+    A dataset the flags do not let the run build (`runner.DatasetUnavailableError`, which names the flag) is an
+    ``app.UsageError``.
+    """
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            outcome = runner.run(spec, WORKDIR.value)
+        except runner.DatasetUnavailableError as error:
+            raise app.UsageError(f"--{error}") from error
+    for message in dict.fromkeys(str(warning.message) for warning in caught):
+        logging.warning("%s", message)
+    return outcome
+
+
+def main(name: str, argv) -> dict:
+    """Runs experiment `name` (`spec_lib.SETUPS`) with the parsed flags; writes results, tables and figures."""
+    if len(argv) > 1:
+        raise app.UsageError(f"unexpected arguments: {argv[1:]}")
+    outcome = run_spec(spec_from_flags(spec_lib.SETUPS[name]))
+    table = tables.write(outcome.results, WORKDIR.value)
+    if name == "visualize":
+        pngs = [visualize.plot_outcome(outcome, WORKDIR.value)]
+    else:
+        pngs = figures.plot(outcome.results, WORKDIR.value)
+    print(table.read_text())
+    print(f"wrote results.json, {table.name} and {len(pngs)} figure{'s' * (len(pngs) != 1)} "
+          f"({', '.join(png.name for png in pngs)}) to {WORKDIR.value}")
+    return outcome.results

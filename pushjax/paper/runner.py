@@ -1,0 +1,222 @@
+"""The one orchestrator: train the models of an `ExperimentSpec`, evaluate them and the baselines, write results.
+
+Every binary under ``experiments/`` (the paper's experiments, ``train`` and ``visualize``) calls `run`. It writes
+``results.json`` to the work directory, in one schema everywhere::
+
+    {"name": <the experiment>,
+     "config": <ExperimentSpec.to_json(): the dataset and training configs, splits, sizes, seeds, ...>,
+     "rows": [{"model", "kind" ("trained" | "baseline"), "train_split", "test_split", "train_size", "seed",
+               "l_scale", "steps", <metrics of pushjax.train.evaluate.error_metrics>}, ...]}
+
+``steps`` is the number of optimisation steps the model has actually taken (a checkpoint can be ahead of the
+requested number). Baseline rows have ``train_split``, ``train_size``, ``seed`` and ``steps`` null. Metrics that
+are undefined (NaN) are written as null. Each sweep trains in ``<workdir>/<train_split>/l<l_scale>/<variants>``
+(checkpoints and ``metrics.csv``), so an interrupted run resumes where it stopped.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import os
+import warnings
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+from absl import logging
+
+from pushjax import data
+from pushjax import train as train_lib
+from pushjax.paper import baselines as baselines_lib, paths
+from pushjax.paper.spec import ExperimentSpec
+from pushjax.train import evaluate
+
+Examples = Mapping[str, np.ndarray]
+
+
+@dataclasses.dataclass(frozen=True)
+class TrainedSweep:
+    """One trained sweep of a run: its variants, training split, ``l`` factor and the trained models."""
+
+    variants: tuple[str, ...]
+    train_split: str
+    l_scale: float
+    result: train_lib.SweepResult
+
+
+@dataclasses.dataclass(frozen=True)
+class RunOutcome:
+    """What `run` returns: the spec, the ``results.json`` content, the trained sweeps and the test sets they met."""
+
+    spec: ExperimentSpec
+    results: dict
+    sweeps: list[TrainedSweep]
+    test_sets: dict[str, Examples]
+
+
+def clip_sizes(sizes: Sequence[int], count: int, split: str = "train") -> tuple[int, ...]:
+    """`sizes` with every size above `count` (the training split's examples) lowered to it, with a warning.
+
+    Empty `sizes` means the whole split. Duplicates that clipping creates are dropped.
+    """
+    if not sizes:
+        return (count,)
+    too_large = [size for size in sizes if size > count]
+    if too_large:
+        warnings.warn(
+            f"sizes: {too_large} exceed the {count} examples of training split {split!r}; clipped to {count}",
+            stacklevel=2,
+        )
+    return tuple(dict.fromkeys(min(size, count) for size in sizes))
+
+
+class DatasetUnavailableError(ValueError):
+    """A dataset the run needs is not built and the run's settings do not let it be built; names the setting."""
+
+
+def load_splits(spec: ExperimentSpec, dataset: data.DatasetConfig, progress: bool = True):
+    """split name -> random-access source of `dataset`, built first when the spec allows it and it is missing.
+
+    Logs which dataset (name, version, folder) it reused or built. Raises `DatasetUnavailableError` before building anything when `dataset` is missing and ``spec.build`` is
+    off, or when it is missing and its data directory is not writable.
+    """
+    builder = data.PushEffects(config=f"{dataset.experiment}_{dataset.scale}", data_dir=spec.data_dir,
+                               seed=dataset.seed)
+    name = data.dataset_name(dataset.experiment, dataset.scale, dataset.seed)
+    reused = builder.is_prepared()
+    if not reused:
+        if not spec.build:
+            raise DatasetUnavailableError(f"build: dataset {name} is not built (looked in {builder.data_dir}) and --nobuild "
+                             "forbids building it; --build builds it there")
+        try:
+            paths.check_writable_folder(builder.data_dir_root)
+        except ValueError as error:
+            message = f"dataset {name} is not built and cannot be built in {builder.data_dir_root}: {error}"
+            raise DatasetUnavailableError(f"data_dir: {message}") from None
+        data.build(dataset.experiment, dataset.scale, data_dir=spec.data_dir, seed=dataset.seed,
+                   workers=spec.workers, progress=progress)
+    logging.info("dataset %s version %s: %s %s", name, builder.VERSION, "reused from" if reused else "built in",
+                 builder.data_dir)
+    return data.load(dataset.experiment, dataset.scale, data_dir=spec.data_dir, seed=dataset.seed)
+
+
+def _split_sources(splits: Mapping, names: Sequence[str], dataset: data.DatasetConfig) -> list:
+    for name in names:
+        if name not in splits:
+            raise ValueError(f"split: {name!r} is not a split of {dataset.experiment}; choose from {sorted(splits)}")
+    return [splits[name] for name in names]
+
+
+def _scale_l(examples: Examples, l_scale: float) -> Examples:
+    return examples if l_scale == 1.0 else {**examples, "l": examples["l"] * np.float32(l_scale)}
+
+
+def finite_or_none(row: Mapping) -> dict:
+    """`row` with NaN and infinite numbers replaced by None (strict JSON)."""
+    return {key: None if isinstance(value, float) and not math.isfinite(value) else value
+            for key, value in row.items()}
+
+
+def train_sweep(spec: ExperimentSpec, variants: Sequence[str], train_examples: Examples, workdir: str | os.PathLike,
+                train_split: str = "train", progress: bool = True, label: str = "") -> train_lib.SweepResult:
+    """Trains `variants` side by side for every (size, seed) of `spec` (error variants share one sweep).
+
+    Args:
+      spec: the run.
+      variants: one variant, or several error variants (`pushjax.models.ERROR_OPTIONS`).
+      train_examples: {field: [N, ...]} the training split.
+      workdir: the sweep's checkpoints and ``metrics.csv``.
+      train_split: the training split's name, for the warning when sizes are clipped.
+      progress: show progress bars.
+      label: what the progress bar says before the models' description (e.g. which sweep of a run).
+    """
+    count = len(train_examples["motion"])
+    per_model_variants = tuple(variants) if len(variants) > 1 else (None,)
+    specs = train_lib.subset_specs(count, clip_sizes(spec.sizes, count, train_split), spec.seeds, per_model_variants)
+    description = f"{label}{train_lib.describe_specs(variants[0], specs)} on {train_split}"
+    return train_lib.sweep(spec.train_config(variants[0]), train_examples, specs, workdir, mode=spec.mode,
+                           progress=progress, description=description)
+
+
+@dataclasses.dataclass(frozen=True)
+class PlannedSweep:
+    """One sweep of a run: its variants, training split and l factor, and its progress label."""
+
+    l_scale: float
+    train_split: str
+    variants: tuple[str, ...]
+    label: str
+
+
+def plan_sweeps(spec: ExperimentSpec, train_splits: Sequence[str]) -> list[PlannedSweep]:
+    """The sweeps `run` trains, in order, each labelled with its number among them (``sweep 2/5: ``)."""
+    keys = [(l_scale, train_split, variants) for l_scale in spec.l_scales for train_split in train_splits
+            for variants in spec.sweep_groups_at(l_scale)]
+    return [PlannedSweep(l_scale, train_split, variants,
+                         f"sweep {number}/{len(keys)}" + (f", l x{l_scale:g}" if l_scale != 1.0 else "") + ": ")
+            for number, (l_scale, train_split, variants) in enumerate(keys, start=1)]
+
+
+def _trained_rows(spec: ExperimentSpec, sweep: TrainedSweep, test_sets: Mapping[str, Examples]) -> list[dict]:
+    result = sweep.result
+    rows = []
+    for test_split, examples in test_sets.items():
+        metrics = evaluate.evaluate_sweep(result, examples, spec.train.eval_batch_size)
+        for k, (model, model_metrics) in enumerate(zip(result.specs, metrics)):
+            rows.append({"model": model.variant or sweep.variants[0], "kind": "trained",
+                         "train_split": sweep.train_split, "test_split": test_split,
+                         "train_size": len(model.train_indices), "seed": model.seed, "l_scale": sweep.l_scale,
+                         "steps": int(result.steps_trained[k]), **model_metrics})
+    return rows
+
+
+def _baseline_rows(spec: ExperimentSpec, test_sets: Mapping[str, Examples], l_scale: float) -> list[dict]:
+    rows = []
+    for baseline in spec.baselines:
+        if not spec.runs_at(baseline, l_scale):
+            continue
+        for test_split, examples in test_sets.items():
+            metrics = evaluate.error_metrics(baselines_lib.predictions(baseline, examples), examples)
+            rows.append({"model": baseline, "kind": "baseline", "train_split": None, "test_split": test_split,
+                         "train_size": None, "seed": None, "l_scale": l_scale, "steps": None, **metrics})
+    return rows
+
+
+def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True) -> RunOutcome:
+    """Trains the spec's variants and evaluates them and its baselines; writes ``<workdir>/results.json``.
+
+    Args:
+      spec: the run (`pushjax.paper.spec.make_spec`).
+      workdir: output folder (see the module docstring).
+      progress: show progress bars.
+    """
+    workdir = Path(workdir)
+    fields = spec.example_fields()
+    splits = load_splits(spec, spec.dataset, progress)
+    train_sources = _split_sources(splits, spec.train_splits, spec.dataset)
+    if spec.test_dataset != spec.dataset:
+        splits = load_splits(spec, spec.test_dataset, progress)
+    test_sources = _split_sources(splits, spec.test_splits, spec.test_dataset)
+    test_sets = {spec.test_split_label(name): train_lib.examples_from_source(source, (*fields, *spec.test_fields))
+                 for name, source in zip(spec.test_splits, test_sources)}
+    rows, sweeps = [], []
+    train_sets = {name: train_lib.examples_from_source(source, fields)
+                  for name, source in zip(spec.train_splits, train_sources)}
+    planned = plan_sweeps(spec, tuple(train_sets))
+    for l_scale in spec.l_scales:
+        scaled_tests = {name: _scale_l(examples, l_scale) for name, examples in test_sets.items()}
+        rows += _baseline_rows(spec, scaled_tests, l_scale)
+        for planned_sweep in (planned_sweep for planned_sweep in planned if planned_sweep.l_scale == l_scale):
+            variants, train_split = planned_sweep.variants, planned_sweep.train_split
+            result = train_sweep(spec, variants, _scale_l(train_sets[train_split], l_scale),
+                                 workdir / train_split / f"l{l_scale:g}" / "_".join(variants), train_split,
+                                 progress, planned_sweep.label)
+            sweep = TrainedSweep(variants, train_split, l_scale, result)
+            sweeps.append(sweep)
+            rows += _trained_rows(spec, sweep, scaled_tests)
+    results = {"name": spec.name, "config": spec.to_json(), "rows": [finite_or_none(row) for row in rows]}
+    workdir.mkdir(parents=True, exist_ok=True)
+    (workdir / "results.json").write_text(json.dumps(results, indent=2))
+    return RunOutcome(spec, results, sweeps, test_sets)

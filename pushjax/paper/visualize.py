@@ -1,0 +1,89 @@
+"""Figs. 7-8 style plots: what each variant predicts for one push seen under many scene transforms.
+
+The ``repeated`` dataset holds one push (`pushjax.data.configs.REPEATED_PUSH`) under random scene rotations
+and translations. Rotating every prediction back by its example's ``scene_transform`` puts them all in the
+frame of the recorded push, so a perfect model would put every point on the true one.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from pushjax import planar  # noqa: E402
+from pushjax.models import ERROR_OPTIONS  # noqa: E402
+from pushjax.paper import runner  # noqa: E402
+from pushjax.train import evaluate  # noqa: E402
+
+
+
+def to_push_frame(vectors: np.ndarray, scene_transforms: np.ndarray) -> np.ndarray:
+    """[N, 2] world-axis vectors rotated back by the inverse of [N, 3, 3] planar scene transforms."""
+    return np.einsum("nji,nj->ni", scene_transforms[:, :2, :2], vectors)
+
+
+def plot(predictions: Mapping[str, Mapping[str, np.ndarray]], examples: Mapping[str, np.ndarray],
+         path: str | os.PathLike) -> Path:
+    """A row per variant: predicted object translations (mm) and predicted contacts with normals (mm).
+
+    Args:
+      predictions: variant -> `evaluate.predict` outputs on `examples`.
+      examples: the ``repeated`` test split, with ``scene_transform``.
+      path: the PNG to write.
+    """
+    transforms = examples["scene_transform"]
+    true_motion = to_push_frame(examples["motion"][:, :2], transforms) * planar.M_TO_MM
+    true_contact = to_push_frame(examples["contact"], transforms) * planar.M_TO_MM
+    true_normal = to_push_frame(examples["normal"], transforms)
+    figure, axes = plt.subplots(len(predictions), 2, figsize=(9, 3.8 * len(predictions)), squeeze=False)
+    for (variant, outputs), (motion_axis, contact_axis) in zip(predictions.items(), axes):
+        motion = to_push_frame(outputs["motion"][:, :2], transforms) * planar.M_TO_MM
+        motion_axis.scatter(motion[:, 0], motion[:, 1], s=8, alpha=0.6, label="predicted")
+        motion_axis.scatter(true_motion[:, 0], true_motion[:, 1], marker="*", color="k", s=60, label="true")
+        motion_axis.set_title(f"{variant}: object translation [mm]")
+        motion_axis.set_aspect("equal", "datalim")
+        contact_axis.scatter(true_contact[:, 0], true_contact[:, 1], marker="*", color="k", s=60, label="true")
+        contact_axis.quiver(true_contact[:1, 0], true_contact[:1, 1], true_normal[:1, 0], true_normal[:1, 1],
+                            color="k", width=0.006)
+        if "contact" not in outputs:
+            contact_axis.text(0.5, 0.5, f"{variant} predicts no contact", ha="center", va="center",
+                              transform=contact_axis.transAxes)
+            contact_axis.set_axis_off()
+        else:
+            contact = to_push_frame(outputs["contact"], transforms) * planar.M_TO_MM
+            contact_axis.scatter(contact[:, 0], contact[:, 1], s=8, alpha=0.6, label="predicted")
+            if "normal" in outputs:
+                normal = to_push_frame(outputs["normal"], transforms)
+                contact_axis.quiver(contact[:, 0], contact[:, 1], normal[:, 0], normal[:, 1], alpha=0.4,
+                                    width=0.003)
+        contact_axis.set_title(f"{variant}: contact point and normal [mm]")
+        contact_axis.set_aspect("equal", "datalim")
+        motion_axis.legend(fontsize="small")
+    figure.tight_layout()
+    figure.savefig(path, dpi=100)
+    plt.close(figure)
+    return Path(path)
+
+
+def plot_outcome(outcome: runner.RunOutcome, workdir: str | os.PathLike) -> Path:
+    """Plots the predictions of each trained variant's first model on the run's (one) test set.
+
+    Writes and returns ``<workdir>/fig8_repeated_pushes.png``.
+    """
+    (examples,) = outcome.test_sets.values()
+    predictions = {}
+    for sweep in outcome.sweeps:
+        result = sweep.result
+        for variant in sweep.variants:
+            k = next(k for k, model in enumerate(result.specs) if model.variant in (None, variant))
+            options = None if result.specs[k].variant is None else np.asarray(ERROR_OPTIONS[variant], np.float32)
+            predictions[variant] = evaluate.predict(result.model, result.model_state(k), examples,
+                                                    outcome.spec.train.eval_batch_size, options)
+    return plot(predictions, examples, Path(workdir) / "fig8_repeated_pushes.png")

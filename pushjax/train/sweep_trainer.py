@@ -1,0 +1,270 @@
+"""The sweep trainer: K models of one architecture trained together, resumable from checkpoints.
+
+A sweep trains K models that share one parameter structure (one `ModelConfig`), each on its own
+training subset (`ModelSpec.train_indices`) with its own seed, e.g. several random subsets for each
+of several training-set sizes (the paper averages over datasets of the same size), optionally mixing
+the error-term variants. ``mode="vmap"`` (the default) updates all K models with one jit-compiled step,
+the single-model step vmapped over the model axis; ``mode="unroll"`` repeats the single-model step K
+times inside the one jitted step; ``mode="sequential"`` calls the jitted single-model step once per
+model at every step. On XLA:CPU a vmapped convolution with per-model kernels becomes a slow grouped
+convolution, and one model's convolutions already keep both cores busy, so ``sequential`` is the
+fastest there (``benchmarks/sweep.py``, ``benchmarks/sweep_breakdown.py``). All modes checkpoint
+the same stacked state, so a sweep can resume in another mode.
+
+Determinism: model k is initialised from ``jax.random.key(spec.seed)`` and draws its batches in an
+order that depends only on its spec and the step (`pushjax.train.batching.batch_indices`), so a sweep
+resumed from a checkpoint replays exactly the batches of an uninterrupted run and ends with the same
+parameters, and a model trained alone draws the same batches as inside a sweep.
+
+Work directory layout: ``checkpoints/<step>/`` (orbax, `pushjax.train.checkpoint`: the stacked
+`TrainState` and metadata identifying the models) and ``metrics.csv`` (one row per logged step and
+model: step, model, name, loss and the loss's metrics in mm / degrees; `pushjax.train.metrics_log`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import os
+import warnings
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import tqdm
+
+from pushjax.models import ERROR_OPTIONS, ModelConfig, PushModel
+from pushjax.train.batching import Examples, ModelSpec, batch_indices, gather, model_fields
+from pushjax.train.checkpoint import Checkpointer
+from pushjax.train.configs import TrainConfig
+from pushjax.train.metrics_log import MetricsLog
+from pushjax.train.train_state import TrainState, create_train_state, make_optimizer, make_train_step
+
+SWEEP_MODES = ("vmap", "unroll", "sequential")
+"""How `sweep` steps its K models (see the module docstring)."""
+
+
+def _error_options(config: ModelConfig, specs: Sequence[ModelSpec]) -> jax.Array | None:
+    """[K, 2] per-model error-term flags, or None when no spec overrides the variant."""
+    if all(spec.variant is None for spec in specs):
+        return None
+    if config.variant not in ERROR_OPTIONS:
+        raise ValueError(
+            f"specs: per-model variants need an error variant model, got variant {config.variant!r}"
+        )
+    return jnp.asarray([ERROR_OPTIONS[spec.variant or config.variant] for spec in specs], jnp.float32)
+
+
+def _stack(trees: Sequence[Any]) -> Any:
+    """K pytrees of one structure -> one pytree whose leaves have a leading axis of size K."""
+    return jax.tree.map(lambda *leaves: jnp.stack(leaves), *trees)
+
+
+def _unstack(tree: Any, count: int) -> list[Any]:
+    """Inverse of `_stack`: the `count` pytrees along the leading axis."""
+    return [jax.tree.map(lambda leaf, k=k: leaf[k], tree) for k in range(count)]
+
+
+@functools.lru_cache(maxsize=16)
+def _compiled_step(
+    model_config: ModelConfig, physics: Callable | None, learning_rate: float, weight_decay: float,
+    mode: str, per_model_options: bool,
+):
+    """The jitted train step of one model ("sequential") or of K stacked models ("vmap", "unroll").
+
+    Cached, so that repeated runs with the same model and optimiser compile once.
+
+    Args:
+      model_config: the models' architecture and variant.
+      physics: replaces `PushModel.physics`, or None for the default.
+      learning_rate: Adam's step size.
+      weight_decay: weight of the loss's weight penalty.
+      mode: one of `SWEEP_MODES`.
+      per_model_options: whether the step takes [K, 2] per-model error-term flags (else None).
+    """
+    model = PushModel(model_config) if physics is None else PushModel(model_config, physics)
+    optimizer = make_optimizer(learning_rate)
+    train_step = make_train_step(model, optimizer, weight_decay)
+    if mode == "sequential":
+        return jax.jit(train_step)
+    if mode == "vmap":
+        return jax.jit(jax.vmap(train_step, in_axes=(0, 0, 0 if per_model_options else None)))
+
+    def unrolled_step(states, batches, error_options):
+        count = jax.tree.leaves(states)[0].shape[0]
+        outputs = [
+            train_step(
+                jax.tree.map(lambda leaf: leaf[k], states), jax.tree.map(lambda leaf: leaf[k], batches),
+                None if error_options is None else error_options[k],
+            )
+            for k in range(count)
+        ]
+        return _stack([state for state, _ in outputs]), _stack([metrics for _, metrics in outputs])
+
+    return jax.jit(unrolled_step)
+
+
+@dataclasses.dataclass(frozen=True)
+class SweepResult:
+    """Outcome of `sweep`.
+
+    Attributes:
+      model: the Flax module (shared by all models).
+      specs: the K models.
+      state: `TrainState` whose leaves have a leading axis of size K.
+      final_metrics: {name: [K]} metrics of the last step taken in this call ({} when it took none,
+        e.g. when resuming a finished sweep).
+    """
+
+    model: PushModel
+    specs: list[ModelSpec]
+    state: TrainState
+    final_metrics: dict[str, np.ndarray]
+
+    @property
+    def steps_trained(self) -> np.ndarray:
+        """[K] int steps each model has trained, restored ones included (read from `state`)."""
+        return np.asarray(self.state.step)
+
+    def model_state(self, index: int) -> TrainState:
+        """The state of model `index` (in [0, K); leaves without the model axis)."""
+        return jax.tree.map(lambda leaf: leaf[index], self.state)
+
+
+def describe_specs(variant: str, specs: Sequence[ModelSpec]) -> str:
+    """A short label of a sweep's models, e.g. ``hybrid: sizes 200,660 x seeds 0,1 (4 models)``."""
+    variants = sorted({spec.variant or variant for spec in specs})
+    sizes = sorted({len(spec.train_indices) for spec in specs})
+    seeds = sorted({spec.seed for spec in specs})
+    return (f"{','.join(variants)}: sizes {','.join(map(str, sizes))} x seeds {','.join(map(str, seeds))} "
+            f"({len(specs)} models)")
+
+
+def sweep(
+    train_config: TrainConfig,
+    examples: Examples,
+    specs: Sequence[ModelSpec],
+    workdir: str | os.PathLike | None = None,
+    *,
+    mode: str = "vmap",
+    physics: Callable | None = None,
+    progress: bool = True,
+    description: str | None = None,
+    step_callback: Callable[[int, Mapping[str, jax.Array]], None] | None = None,
+) -> SweepResult:
+    """Trains K = len(specs) models of `train_config.model` for `train_config.num_steps` steps.
+
+    Args:
+      train_config: model, optimiser and schedule.
+      examples: the training split, {field: [N, ...] NumPy array} (schema fields; at least
+        `model_fields`).
+      specs: the models (subsets and seeds).
+      workdir: folder for checkpoints and ``metrics.csv``; when it holds a checkpoint of the same
+        specs, training resumes from it (in any mode). A checkpoint already past
+        `train_config.num_steps` is returned as it is, with a warning naming the work directory, its
+        step and the requested steps (`SweepResult.steps_trained` says how far the models trained).
+        None: no checkpoints, no log.
+      mode: one of `SWEEP_MODES`: "vmap" or "unroll": one jitted step for all K models;
+        "sequential": the jitted single-model step once per model at every step (see the module
+        docstring).
+      physics: replaces `PushModel.physics` (default `lynch.predict`).
+      progress: show a progress bar with the running loss (mean over models).
+      description: the progress bar's label; by default the variants, subset sizes and seeds of `specs`.
+      step_callback: called after every step with the number of completed steps and
+        that step's metrics ({name: [K]} device arrays).
+
+    Returns:
+      the `SweepResult`.
+    """
+    if not specs:
+        raise ValueError("specs: expected at least one model")
+    if mode not in SWEEP_MODES:
+        raise ValueError(f"mode: expected one of {SWEEP_MODES}, got {mode!r}")
+    model_config = train_config.model
+    model = PushModel(model_config) if physics is None else PushModel(model_config, physics)
+    optimizer = make_optimizer(train_config.learning_rate)
+    options = _error_options(model_config, specs)
+    step_fn = _compiled_step(
+        model_config, physics, train_config.learning_rate, train_config.weight_decay, mode,
+        options is not None,
+    )
+    fields = model_fields(model_config)
+    num_examples = len(examples[fields[0]]) if fields[0] in examples else 0
+    for spec in specs:
+        if spec.train_indices.max(initial=0) >= num_examples or spec.train_indices.min() < 0:
+            raise ValueError(f"specs: {spec.name!r} indexes outside the {num_examples} training examples")
+    example_batch = gather(examples, batch_indices(specs[0], 0, train_config.batch_size), fields)
+
+    def batch_at(spec, step):
+        return gather(examples, batch_indices(spec, step, train_config.batch_size), fields)
+
+    state = _stack([create_train_state(model, optimizer, example_batch, spec.seed) for spec in specs])
+    start = 0
+    checkpointer = log = None
+    names = [spec.name for spec in specs]
+    identity = {
+        "names": names,
+        "seeds": [spec.seed for spec in specs],
+        "subset_sizes": [len(spec.train_indices) for spec in specs],
+        "subset_checksums": [int(np.asarray(spec.train_indices, np.int64).sum()) for spec in specs],
+        "variant": model_config.variant,
+    }
+    if workdir is not None:
+        workdir = Path(workdir)
+        workdir.mkdir(parents=True, exist_ok=True)
+        checkpointer = Checkpointer(workdir / "checkpoints")
+        metadata = checkpointer.latest_metadata()
+        if metadata is not None:
+            if metadata.get("identity") != identity:
+                checkpointer.close()
+                raise ValueError(
+                    f"workdir: {workdir} holds a checkpoint of different models "
+                    f"({metadata.get('identity')}); use a fresh work directory"
+                )
+            start, state, _ = checkpointer.restore_latest(state)
+            if start > train_config.num_steps:
+                warnings.warn(
+                    f"workdir: {workdir} holds a checkpoint at step {start}, past the requested num_steps "
+                    f"{train_config.num_steps}; the sweep returns the models as trained for {start} steps",
+                    stacklevel=2)
+        log = MetricsLog(workdir / "metrics.csv", start)
+    if mode == "sequential":
+        def advance(models, batches):
+            outputs = [step_fn(models[k], batches[k], None if options is None else options[k])
+                       for k in range(len(specs))]
+            return [model_state for model_state, _ in outputs], _stack([metrics for _, metrics in outputs])
+
+        models, stacked = _unstack(state, len(specs)), _stack
+    else:
+        def advance(models, batches):
+            return step_fn(models, {name: np.stack([b[name] for b in batches]) for name in fields}, options)
+
+        models, stacked = state, lambda stacked_state: stacked_state
+
+    metrics = None
+    with tqdm.tqdm(
+        total=train_config.num_steps, initial=start, disable=not progress,
+        desc=description or describe_specs(model_config.variant, specs),
+    ) as bar:
+        for step in range(start, train_config.num_steps):
+            models, metrics = advance(models, [batch_at(spec, step) for spec in specs])
+            done = step + 1
+            bar.update(1)
+            if done % train_config.log_every == 0 or done == train_config.num_steps:
+                host_metrics = jax.tree.map(np.asarray, metrics)
+                bar.set_postfix(loss=f"{host_metrics['loss'].mean():.3f}")
+                if log is not None:
+                    log.append(done, names, host_metrics)
+            if checkpointer is not None and (
+                done % train_config.checkpoint_every == 0 or done == train_config.num_steps
+            ):
+                checkpointer.save(done, stacked(models), {"identity": identity})
+            if step_callback is not None:
+                step_callback(done, metrics)
+    if checkpointer is not None:
+        checkpointer.close()
+    final_metrics = {} if metrics is None else jax.tree.map(np.asarray, metrics)
+    return SweepResult(model, list(specs), stacked(models), final_metrics)

@@ -1,0 +1,46 @@
+"""The orchestrator's reports: which dataset a run reads, and what its progress bars name."""
+
+import logging
+
+from pushjax.paper import runner
+from pushjax.paper import spec as spec_lib
+from pushjax.train import describe_specs, subset_specs
+
+
+def test_load_splits_says_which_dataset_it_reused(smoke_data, caplog):
+    data_dir = smoke_data("data_efficiency")
+    spec = spec_lib.make_spec(spec_lib.SETUPS["data_efficiency"], "smoke", data_dir=data_dir, build=False)
+    with caplog.at_level(logging.INFO, logger="absl"):
+        splits = runner.load_splits(spec, spec.dataset, progress=False)
+    assert "train" in splits
+    [message] = [record.getMessage() for record in caplog.records if record.getMessage().startswith("dataset push_effects")]
+    assert message.startswith("dataset push_effects/data_efficiency_smoke version 1.0.0: reused from ")
+    assert str(data_dir) in message
+
+
+def test_load_splits_says_where_it_built_a_dataset(tmp_path, caplog):
+    spec = spec_lib.make_spec(spec_lib.SETUPS["velocities"], "smoke", data_dir=tmp_path)
+    with caplog.at_level(logging.INFO, logger="absl"):
+        runner.load_splits(spec, spec.dataset, progress=False)
+    [message] = [record.getMessage() for record in caplog.records if record.getMessage().startswith("dataset push_effects")]
+    assert message.startswith("dataset push_effects/velocities_smoke version 1.0.0: built in ")
+    assert str(tmp_path) in message
+
+
+def test_progress_labels_name_the_variants_sizes_and_seeds():
+    specs = subset_specs(100, (20, 50), (0, 3), ("error", "error_norm"))
+    assert describe_specs("error", specs) == "error,error_norm: sizes 20,50 x seeds 0,3 (8 models)"
+    assert describe_specs("hybrid", subset_specs(100, (20,), (1,), (None,))) == "hybrid: sizes 20 x seeds 1 (1 models)"
+
+
+def test_every_sweep_of_a_run_is_numbered_in_its_label():
+    spec = spec_lib.make_spec(spec_lib.SETUPS["error_variants"], "smoke")
+    planned = runner.plan_sweeps(spec, ("train",))
+    assert [(sweep.l_scale, sweep.variants, sweep.label) for sweep in planned] == [
+        (1.0, ("hybrid",), "sweep 1/6: "),
+        (1.0, ("error", "error_grad", "error_norm"), "sweep 2/6: "),
+        (1.5, ("hybrid",), "sweep 3/6, l x1.5: "),
+        (1.5, ("error",), "sweep 4/6, l x1.5: "),
+        (3.0, ("hybrid",), "sweep 5/6, l x3: "),
+        (3.0, ("error",), "sweep 6/6, l x3: "),
+    ]
