@@ -2,7 +2,8 @@ r"""Record simulated MIT Push Dataset files (MuJoCo, MIT protocol and raw layout
 
   python -m experiments.record_pushes --out_dir=/tmp/pushes --objects=rect1,tri2 --surfaces=abs \
       --velocities=20,50 --pushes=100 --seed=0 [--accelerations=0] [--repeats=1] [--workers=2] \
-      [--effects='com_offset=0.01,0.0;table_tilt_deg=1.0'] [--declare_effects=false] [--support=grid]
+      [--effects='com_offset=0.01,0.0;table_tilt_deg=1.0'] [--declare_effects=false] [--support=grid] \
+      [--testbed=realistic] [--testbed_overrides='drop_rate=0;friction_field_sigma=0.2']
 
 Pushes are drawn from the MIT grid (side, contact point, angle; velocity and acceleration from the flags) and
 written to ``<out_dir>/<surface>/<object>/motion_surface=..._shape=..._a=..._v=..._i=..._s=..._t=...h5``.
@@ -16,6 +17,14 @@ flags may record into one folder at once.
 com_offset=dx,dy (m); pressure_rim=k; friction_anisotropy=kx,ky; table_tilt_deg=deg;
 table_tilt_azimuth_deg=deg; pusher_friction=mu; tracking_noise=sigma_xy,sigma_yaw (m, rad);
 tracking_bias=dx,dy,dyaw (m, m, rad). See ``pushjax.sim.effects`` for what each one does.
+
+``--testbed`` picks the testbed profile of ``pushjax.sim.testbed``: ``ideal`` (every push exactly as Lynch's
+quasi-static model assumes, the default for now) or ``realistic`` (uneven support pressure, friction varying over
+the table, with the object, with the sliding speed and from push to push, and a motion-capture system with noise,
+time-stamp jitter and dropped samples). ``--testbed_overrides`` changes single magnitudes of the profile,
+``name=value`` items separated by ``;`` (0 switches a mechanism off), e.g. ``--testbed=realistic
+--testbed_overrides='drop_rate=0;pusher_friction_sigma=0.1'``; the fields are those of
+``pushjax.sim.testbed.Testbed``.
 """
 
 import math
@@ -27,6 +36,7 @@ from pushjax.geometry import OBJECT_NAMES
 from pushjax.sim.dataset import OutDirConflictError, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
+from pushjax.sim.testbed import PROFILES, from_flags
 
 _OUT_DIR = flags.DEFINE_string("out_dir", None, "Dataset root directory.", required=True)
 _OBJECTS = flags.DEFINE_list("objects", ["rect1"], f"Objects, from {','.join(OBJECT_NAMES)}.")
@@ -40,6 +50,10 @@ _DECLARE = flags.DEFINE_bool("declare_effects", True, "Write effects and seed as
 _REPEATS = flags.DEFINE_integer("repeats", 1, "Files per drawn push (_rep=NNNN when > 1).", lower_bound=1)
 _WORKERS = flags.DEFINE_integer("workers", None, "Worker processes (default: all cores).", lower_bound=1)
 _SUPPORT = flags.DEFINE_enum("support", "grid", ["grid", "hull"], "Support points of the object.")
+_TESTBED = flags.DEFINE_enum("testbed", "ideal", list(PROFILES), "Testbed profile (pushjax.sim.testbed).")
+_TESTBED_OVERRIDES = flags.DEFINE_string(
+    "testbed_overrides", "",
+    "Magnitudes of the testbed profile to change, e.g. 'drop_rate=0;friction_field_sigma=0.2'.")
 
 
 def _numbers(flag: str, values: list[str], low: float, strict: bool) -> list[float]:
@@ -69,12 +83,21 @@ def _effects(spec: str) -> bool:
     return True
 
 
+def _testbed_overrides(spec: str) -> bool:
+    try:
+        from_flags("ideal", spec)
+    except ValueError as error:
+        raise flags.ValidationError(f"--testbed_overrides={spec!r}: {error}") from None
+    return True
+
+
 experiments.require_writable_folder("out_dir")
 flags.register_validator("objects", lambda v: _names("objects", v, OBJECT_NAMES))
 flags.register_validator("surfaces", lambda v: _names("surfaces", v, SURFACE_NAMES))
 flags.register_validator("velocities", lambda v: _numbers("velocities", v, 0.0, strict=True) is not None)
 flags.register_validator("accelerations", lambda v: _numbers("accelerations", v, 0.0, strict=False) is not None)
 flags.register_validator("effects", _effects)
+flags.register_validator("testbed_overrides", _testbed_overrides)
 
 
 def main(argv):
@@ -86,7 +109,8 @@ def main(argv):
             velocities=_numbers("velocities", _VELOCITIES.value, 0.0, strict=True),
             accelerations=_numbers("accelerations", _ACCELERATIONS.value, 0.0, strict=False),
             repeats=_REPEATS.value, effects=Effects.parse(_EFFECTS.value), declare_effects=_DECLARE.value,
-            support=_SUPPORT.value, workers=_WORKERS.value)
+            support=_SUPPORT.value, testbed=from_flags(_TESTBED.value, _TESTBED_OVERRIDES.value),
+            workers=_WORKERS.value)
     except OutDirConflictError as error:
         raise app.UsageError(f"--{error}") from None
     print(f"wrote {len(summary.written)} files ({len(summary.rerecorded)} replacing invalid files), "

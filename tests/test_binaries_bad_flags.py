@@ -162,6 +162,10 @@ CASES = [
     ("record_pushes", ["--out_dir={tmp}/pushes", "--repeats=0"], "--repeats"),
     ("record_pushes", ["--out_dir={tmp}/pushes", "--workers=0"], "--workers"),
     ("record_pushes", ["--out_dir={tmp}/pushes", "--support=disc"], "--support"),
+    ("record_pushes", ["--out_dir={tmp}/pushes", "--testbed=perfect"], "--testbed"),
+    ("record_pushes", ["--out_dir={tmp}/pushes", "--testbed_overrides=drop_rate=2"], "--testbed_overrides"),
+    ("record_pushes", ["--out_dir={tmp}/pushes", "--testbed_overrides=wind=1"], "--testbed_overrides"),
+    ("record_pushes", ["--out_dir={tmp}/pushes", "--testbed_overrides=drop_rate"], "--testbed_overrides"),
     ("record_pushes", ["--out_dir={tmp}/pushes", "extra"], "unexpected arguments"),
     # close_loop
     ("close_loop", ["--workdir={tmp}/loop"], "--data_dir"),

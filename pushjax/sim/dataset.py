@@ -4,11 +4,13 @@ Determinism: the pushes of an (object, surface) pair are drawn one after another
 ``np.random.default_rng([seed, crc32(object), crc32(surface), i])`` (a push whose file name was already drawn is
 drawn again from the same generator), in the calling process; each push is then simulated from the same
 settled state in whichever worker, with its tracking noise drawn from a generator seeded by
-``[seed, crc32(object), crc32(surface), i, repetition]``. So the same arguments give byte-identical files for
-any number of workers.
+``[seed, crc32(object), crc32(surface), i, repetition]``. A non-ideal testbed (:mod:`pushjax.sim.testbed`) draws
+its per-surface, per-object and per-push conditions from generators seeded by the same seed, names and key
+(:func:`pushjax.sim.testbed.draw_conditions`). So the same arguments give byte-identical files for any number of
+workers.
 
 Resuming: :func:`record_pushes` keeps the settings that determine every file's bytes (seed, velocities,
-accelerations, repeats, effects, declare_effects, support and the MuJoCo version) in ``<out_dir>/``
+accelerations, repeats, effects, declare_effects, support, testbed and the MuJoCo version) in ``<out_dir>/``
 :data:`MANIFEST_NAME`, written before the first file. A later call into the same folder must have the same
 settings (it may ask for other objects, surfaces or push counts: under the same settings a file's name fixes its
 bytes), else it is refused with :class:`OutDirConflictError`; a folder that holds ``.h5`` files but no manifest
@@ -40,6 +42,7 @@ from pushjax.sim import scene
 from pushjax.sim.effects import Effects
 from pushjax.sim.push import simulate_push
 from pushjax.sim.surfaces import SURFACE_NAMES, get_surface
+from pushjax.sim.testbed import IDEAL, Testbed, draw_conditions
 
 _MAX_DRAWS_PER_PUSH = 1000
 """Draws after which a push that keeps hitting already drawn file names gives up."""
@@ -62,8 +65,10 @@ class PushJob:
       params: the push (``repetition`` set when repeats are recorded).
       effects: the effects to simulate.
       support: the support mode.
-      noise_seed: entropy of the tracking-noise generator.
+      noise_seed: entropy of the tracking-noise generator; under a non-ideal testbed also the push's key of
+        :func:`pushjax.sim.testbed.draw_conditions`, whose first element is the data set's seed.
       attributes: the HDF5 attributes to write, or None for a file with the three datasets only.
+      testbed: the testbed profile (:mod:`pushjax.sim.testbed`).
     """
 
     path: Path
@@ -72,6 +77,7 @@ class PushJob:
     support: str
     noise_seed: tuple[int, ...]
     attributes: dict | None
+    testbed: Testbed = IDEAL
 
 
 @dataclasses.dataclass(frozen=True)
@@ -105,9 +111,12 @@ def plan_pushes(
     effects: Effects = Effects(),
     declare_effects: bool = True,
     support: str = "grid",
+    testbed: Testbed = IDEAL,
 ) -> list[PushJob]:
     """The files to record, in a deterministic order; arguments as in :func:`record_pushes`."""
     _check_arguments(objects, surfaces, pushes, seed, velocities, accelerations, repeats, effects, support)
+    if not isinstance(testbed, Testbed):
+        raise ValueError(f"testbed: expected a Testbed, got {type(testbed).__name__}")
     jobs = []
     for obj in objects:
         shape = get_object(obj)
@@ -141,18 +150,32 @@ def plan_pushes(
                             "pushjax_initial_pose": np.zeros(3),
                             "pushjax_simulator": f"mujoco {mujoco.__version__}",
                         }
+                        if not testbed.ideal:
+                            attributes["pushjax_testbed"] = testbed.to_json()
                     jobs.append(PushJob(
                         path=push_file_path(out_dir, repeated), params=repeated, effects=effects, support=support,
-                        noise_seed=key + (repetition,), attributes=attributes))
+                        noise_seed=key + (repetition,), attributes=attributes, testbed=testbed))
     return jobs
 
 
 def record_push(job: PushJob) -> Path:
-    """Simulates one planned push and writes its file (atomically)."""
+    """Simulates one planned push and writes its file (atomically).
+
+    Under a non-ideal testbed a declaring file also gets ``pushjax_testbed_draw``, the JSON of the push's scalar
+    draws (:meth:`pushjax.sim.testbed.PushConditions.draws`).
+    """
     rng = np.random.default_rng(job.noise_seed)
-    recording = simulate_push(dataclasses.replace(job.params, repetition=None), job.effects, job.support, rng=rng)
+    conditions, attributes = None, job.attributes
+    if not job.testbed.ideal:
+        supports = len(scene.support_points(job.params.shape, job.support)[0])
+        conditions = draw_conditions(job.testbed, job.noise_seed[0], job.params.shape, job.params.surface,
+                                     job.noise_seed, supports)
+        if attributes is not None:
+            attributes = {**attributes, "pushjax_testbed_draw": json.dumps(conditions.draws(), sort_keys=True)}
+    recording = simulate_push(dataclasses.replace(job.params, repetition=None), job.effects, job.support, rng=rng,
+                              conditions=conditions)
     return write_push(job.path, job.params, recording.tip_pose, recording.object_pose, recording.ft_wrench,
-                      attributes=job.attributes)
+                      attributes=attributes)
 
 
 def record_pushes(
@@ -167,6 +190,7 @@ def record_pushes(
     effects: Effects = Effects(),
     declare_effects: bool = True,
     support: str = "grid",
+    testbed: Testbed = IDEAL,
     workers: int | None = None,
     progress: bool = True,
 ) -> RecordSummary:
@@ -190,6 +214,8 @@ def record_pushes(
       declare_effects: write the effects, seed etc. as HDF5 attributes; False writes exactly the three datasets
         of a real MIT file.
       support: support mode (``grid`` or ``hull``).
+      testbed: the testbed profile (:mod:`pushjax.sim.testbed`; default :data:`~pushjax.sim.testbed.IDEAL`, the
+        files of the ideal testbed are those recorded before testbeds existed).
       workers: worker processes (default: all cores); 1 records in this process.
       progress: show a tqdm progress bar.
 
@@ -204,9 +230,9 @@ def record_pushes(
     if workers is not None and (not isinstance(workers, int) or workers < 1):
         raise ValueError(f"workers: expected an integer >= 1, got {workers!r}")
     jobs = plan_pushes(out_dir, objects, surfaces, pushes, seed, velocities, accelerations, repeats, effects,
-                       declare_effects, support)
+                       declare_effects, support, testbed)
     _claim_out_dir(Path(out_dir), recording_settings(seed, velocities, accelerations, repeats, effects,
-                                                     declare_effects, support))
+                                                     declare_effects, support, testbed))
     skipped, todo, invalid = [], [], {}
     for job in jobs:
         if not job.path.exists():
@@ -248,11 +274,13 @@ def recording_settings(
     effects: Effects,
     declare_effects: bool,
     support: str,
+    testbed: Testbed = IDEAL,
 ) -> dict:
     """The settings that fix the bytes of every file :func:`record_pushes` writes, as JSON values.
 
     Arguments as in :func:`record_pushes` (velocities in mm/s, accelerations in mm/s², both in draw order);
-    ``simulator`` adds the MuJoCo version.
+    ``simulator`` adds the MuJoCo version. A manifest written before testbeds existed has no ``testbed``; it counts
+    as the ideal testbed (:data:`_LEGACY_SETTINGS`).
     """
     return {
         "seed": int(seed),
@@ -262,8 +290,13 @@ def recording_settings(
         "effects": effects.to_dict(),
         "declare_effects": bool(declare_effects),
         "support": support,
+        "testbed": testbed.to_dict(),
         "simulator": f"mujoco {mujoco.__version__}",
     }
+
+
+_LEGACY_SETTINGS = {"testbed": IDEAL.to_dict()}
+"""Settings that manifests written before they existed hold implicitly."""
 
 
 def _claim_out_dir(out_dir: Path, settings: dict) -> None:
@@ -299,6 +332,7 @@ def _claim_out_dir(out_dir: Path, settings: dict) -> None:
         recorded = json.loads(manifest.read_text(encoding="utf-8"))["settings"]
         if not isinstance(recorded, dict):
             raise TypeError(f"settings must be a JSON object, got {type(recorded).__name__}")
+        recorded = {**_LEGACY_SETTINGS, **recorded}
     except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError) as error:
         raise OutDirConflictError(
             f"out_dir: {manifest} is not a readable record_pushes manifest ({error!r}); record into a new folder"

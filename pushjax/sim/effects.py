@@ -72,9 +72,9 @@ class Effects:
                 raise ValueError(f"{name}: expected {size} numbers, got {len(vector)}")
             object.__setattr__(self, name, vector)
         for name in ("pressure_rim", "table_tilt_deg", "table_tilt_azimuth_deg"):
-            object.__setattr__(self, name, _as_float(name, getattr(self, name)))
+            object.__setattr__(self, name, as_float(name, getattr(self, name)))
         if self.pusher_friction is not None:
-            object.__setattr__(self, "pusher_friction", _as_float("pusher_friction", self.pusher_friction))
+            object.__setattr__(self, "pusher_friction", as_float("pusher_friction", self.pusher_friction))
         for name in ("com_offset", "friction_anisotropy", "tracking_noise", "tracking_bias"):
             if not all(math.isfinite(v) for v in getattr(self, name)):
                 raise ValueError(f"{name}: expected finite numbers, got {getattr(self, name)}")
@@ -118,13 +118,7 @@ class Effects:
         ``pusher_friction=none`` restores the default pusher friction.
         """
         values: dict[str, Any] = {}
-        for item in filter(None, (part.strip() for part in spec.split(";"))):
-            name, separator, text = item.partition("=")
-            name = name.strip()
-            if not separator or not text.strip():
-                raise ValueError(f"effects: expected 'name=value', got {item!r}")
-            if name in values:
-                raise ValueError(f"effects: {name!r} given twice")
+        for name, text in parse_assignments(spec, "effects").items():
             components = [component.strip() for component in text.split(",")]
             if name in _VECTOR_SIZES:
                 values[name] = components
@@ -145,7 +139,24 @@ class Effects:
         return cls(**values)
 
 
-def _as_float(name: str, value: Any) -> float:
+def parse_assignments(spec: str, what: str) -> dict[str, str]:
+    """``{name: value text}`` of the command-line syntax ``name=value;name=value`` (empty string: ``{}``).
+
+    Raises a ValueError starting with `what` (e.g. the flag) for an item without a value or a name given twice.
+    """
+    values: dict[str, str] = {}
+    for item in filter(None, (part.strip() for part in spec.split(";"))):
+        name, separator, text = item.partition("=")
+        name = name.strip()
+        if not separator or not text.strip():
+            raise ValueError(f"{what}: expected 'name=value', got {item!r}")
+        if name in values:
+            raise ValueError(f"{what}: {name!r} given twice")
+        values[name] = text.strip()
+    return values
+
+
+def as_float(name: str, value: Any) -> float:
     try:
         number = float(value)
     except (TypeError, ValueError):

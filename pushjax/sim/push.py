@@ -7,7 +7,9 @@ any sliding after the push is recorded.
 Recording (250 Hz, one clock, ``t`` from 0 at the start of the pusher's motion):
 
 * ``tip_pose`` [t, x, y, 0]: the simulated pusher tip's centre (m; the tip does not turn).
-* ``object_pose`` [t, x, y, yaw]: the object's tracked frame (m, rad in (-π, π]), after the tracking effects.
+* ``object_pose`` [t, x, y, yaw]: the object's tracked frame (m, rad in (-π, π]), after the tracking effects
+  (and, under a non-ideal testbed, :mod:`pushjax.sim.testbed`'s motion capture: noise, time-stamp jitter and
+  dropped samples, so this stream may have fewer rows and off-grid time stamps).
 * ``ft_wrench`` [t, fx, fy, torque]: the force (N) that the pusher applies to the object, world axes, and its
   moment (N·m) about the pusher's axis, which only pusher–object friction makes non-zero; both averaged over the
   4 ms before ``t`` like a low-pass filtered force-torque sensor (the sample at ``t = 0`` is instantaneous).
@@ -19,6 +21,12 @@ simulated one. The time step is ``4 ms / n`` with the smallest ``n >= 2`` for wh
 0.1 mm per step (2 ms up to 50 mm/s, 0.2 ms at 500 mm/s). Before any push the object settles on the table for
 0.3 s (with gravity normal to the table); every push starts from that settled state, placed at the requested
 pose, with a zero solver warm start, so a push's result does not depend on the pushes simulated before it.
+
+Testbed (:mod:`pushjax.sim.testbed`): a push simulated with :class:`~pushjax.sim.testbed.PushConditions` is stepped
+one simulation step at a time; before every step the support contacts' coefficients are set from the conditions
+at the support points' current world positions and sliding speeds (load distribution, friction field, speed),
+and the pusher–object coefficient from the push's draw. Without conditions (the ideal testbed) the push runs as a
+single ``mujoco.rollout`` call with the model's fixed coefficients.
 """
 
 from __future__ import annotations
@@ -38,6 +46,7 @@ from pushjax.mit.files import PushParams
 from pushjax.mit.protocol import push_duration, pusher_line, pusher_motion
 from pushjax.sim import scene
 from pushjax.sim.effects import Effects
+from pushjax.sim.testbed import PushConditions
 
 SAMPLE_RATE = 250.0
 """Recording rate in Hz."""
@@ -61,7 +70,8 @@ class Recording:
     Attributes:
       params: the push.
       tip_pose: [N, 4] rows [t s, x m, y m, yaw rad (0)].
-      object_pose: [N, 4] rows [t s, x m, y m, yaw rad] as recorded (with the tracking effects).
+      object_pose: [M, 4] rows [t s, x m, y m, yaw rad] as recorded (with the tracking effects; M = N unless a
+        testbed drops samples).
       ft_wrench: [N, 4] rows [t s, fx N, fy N, torque N·m].
       true_object_pose: [N, 4] the simulated pose of the tracked frame, before the tracking effects.
     """
@@ -97,6 +107,13 @@ class Simulator:
         self._state_spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
         self._control_spec = int(mujoco.mjtState.mjSTATE_CTRL) | int(mujoco.mjtState.mjSTATE_MOCAP_POS)
         self._settled_object = self._settle()
+        self._support_local, self._support_areas = scene.support_points(self.obj, support)
+        # MuJoCo may swap the two geoms of a pair, so a pair is found by either.
+        pair_geoms = np.stack([self.model.pair_geom1, self.model.pair_geom2], axis=1)
+        self._support_pairs = np.array([
+            int(np.flatnonzero((pair_geoms == self.model.geom(f"support{k}").id).any(axis=1))[0])
+            for k in range(len(self._support_local))])
+        self._pusher_pairs = np.flatnonzero((pair_geoms == self.model.geom("pusher_tip").id).any(axis=1))
 
     def _settle(self) -> np.ndarray:
         """[7] free-joint qpos of the object resting at the origin (gravity normal to the table)."""
@@ -118,13 +135,15 @@ class Simulator:
         return settled
 
     def run(self, params: PushParams, initial_pose: Sequence[float] = (0.0, 0.0, 0.0),
-            rng: np.random.Generator | None = None) -> Recording:
+            rng: np.random.Generator | None = None, conditions: PushConditions | None = None) -> Recording:
         """Simulates and records one push.
 
         Args:
           params: the push (its ``shape`` must be this simulator's object).
           initial_pose: (x m, y m, yaw rad) of the object's tracked frame at the start.
           rng: random generator for the tracking noise; required when ``effects.tracking_noise`` is non-zero.
+          conditions: the testbed's draw for this push (:func:`pushjax.sim.testbed.draw_conditions`; its
+            ``plate_pressure`` must have one value per support point); None: the ideal testbed.
 
         Returns:
           The :class:`Recording`.
@@ -138,6 +157,9 @@ class Simulator:
         if pose.shape != (3,) or not np.all(np.isfinite(pose)):
             raise ValueError(f"initial_pose: expected finite (x, y, yaw), got {initial_pose!r}")
         noisy = any(self.effects.tracking_noise)
+        if conditions is not None and len(conditions.plate_pressure) != len(self._support_pairs):
+            raise ValueError(f"conditions: {len(conditions.plate_pressure)} support values for "
+                             f"{len(self._support_pairs)} support points")
         if noisy and rng is None:
             raise ValueError("rng: required to draw the tracking noise of these effects")
 
@@ -169,13 +191,16 @@ class Simulator:
         data.qvel[self._pusher_qvel:self._pusher_qvel + 2] = pusher_motion(params, np.zeros(1))[1][0] * direction
         initial_state = np.empty(mujoco.mj_stateSize(model, self._state_spec))
         mujoco.mj_getState(model, data, initial_state, self._state_spec)
-        states, sensors = rollout.rollout(
-            model, data, initial_state[None], control[None], control_spec=self._control_spec,
-            initial_warmstart=np.zeros((1, model.nv)))
-        states, sensors = states[0], sensors[0]
+        if conditions is None:
+            states, sensors = rollout.rollout(
+                model, data, initial_state[None], control[None], control_spec=self._control_spec,
+                initial_warmstart=np.zeros((1, model.nv)))
+            qpos_steps, sensors = states[0][:, 1:1 + model.nq], sensors[0]
+        else:
+            qpos_steps, sensors = self._stepped(control, conditions)
 
-        # states[k] follows step k; prepend the initial state so that index k is time k * timestep.
-        qpos_path = np.concatenate([initial_state[None, 1:1 + model.nq], states[:, 1:1 + model.nq]])
+        # qpos_steps[k] follows step k; prepend the initial state so that index k is time k * timestep.
+        qpos_path = np.concatenate([initial_state[None, 1:1 + model.nq], qpos_steps])
         sampled = qpos_path[::steps_per_sample]
         times = np.arange(samples) * SAMPLE_PERIOD
         object_qpos = sampled[:, self._object_qpos:self._object_qpos + 7]
@@ -192,8 +217,43 @@ class Simulator:
         ft_wrench = np.column_stack([times, averaged])
 
         recorded = _tracked(true_pose, self.effects, rng if noisy else None)
+        if conditions is not None:
+            recorded = conditions.track(recorded)
         return Recording(params=params, tip_pose=tip_pose, object_pose=recorded, ft_wrench=ft_wrench,
                          true_object_pose=true_pose)
+
+    def _stepped(self, control: np.ndarray, conditions: PushConditions) -> tuple[np.ndarray, np.ndarray]:
+        """([nstep, nq] qpos after each step, [nstep, nsensordata] sensors at the state before each step) of the
+        push whose initial state ``self.data`` holds, with the support and pusher coefficients of ``conditions``
+        set before every step (the model's coefficients are restored afterwards)."""
+        model, data = self.model, self.data
+        nominal = model.pair_friction.copy()
+        support_nominal = nominal[self._support_pairs, :2]
+        data.qacc_warmstart[:] = 0.0
+        nstep = len(control)
+        qpos_steps = np.empty((nstep, model.nq))
+        sensors = np.empty((nstep, model.nsensordata))
+        first = self._object_qpos
+        dof = int(model.jnt_dofadr[model.joint("object_joint").id])
+        try:
+            model.pair_friction[self._pusher_pairs, :2] = nominal[self._pusher_pairs, :2] * conditions.pusher_friction
+            for k in range(nstep):
+                qpos, qvel = data.qpos, data.qvel
+                yaw = float(_yaw(qpos[first + 3:first + 7][None])[0])
+                offsets = planar.rotate(self._support_local, yaw)
+                points = qpos[first:first + 2] + offsets
+                # Free joint: linear velocity in the world frame, angular velocity in the body frame (plate ~level).
+                velocities = qvel[dof:dof + 2] + qvel[dof + 5] * np.stack([-offsets[:, 1], offsets[:, 0]], axis=1)
+                factors = conditions.support_factors(points, np.linalg.norm(velocities, axis=1), self._support_areas)
+                model.pair_friction[self._support_pairs, :2] = support_nominal * factors[:, None]
+                data.ctrl[:] = control[k, :4]
+                data.mocap_pos[0] = control[k, 4:7]
+                mujoco.mj_step(model, data)
+                qpos_steps[k] = data.qpos
+                sensors[k] = data.sensordata
+        finally:
+            model.pair_friction[:] = nominal
+        return qpos_steps, sensors
 
 
 def _tracked(true_pose: np.ndarray, effects: Effects, rng: np.random.Generator | None) -> np.ndarray:
@@ -237,6 +297,6 @@ def simulator(obj: str, surface: str, effects: Effects = Effects(), support: str
 
 def simulate_push(params: PushParams, effects: Effects = Effects(), support: str = "grid",
                   initial_pose: Sequence[float] = (0.0, 0.0, 0.0),
-                  rng: np.random.Generator | None = None) -> Recording:
+                  rng: np.random.Generator | None = None, conditions: PushConditions | None = None) -> Recording:
     """Simulates one push (object and surface from ``params``); see :meth:`Simulator.run`."""
-    return simulator(params.shape, params.surface, effects, support).run(params, initial_pose, rng)
+    return simulator(params.shape, params.surface, effects, support).run(params, initial_pose, rng, conditions)

@@ -13,6 +13,8 @@ import pytest
 from pushjax.mit.files import load_push, parse_push_file_name, read_raw_push, write_push
 from pushjax.sim import dataset
 from pushjax.sim.effects import Effects
+from pushjax.sim.testbed import REALISTIC
+from pushjax.sim.testbed import Testbed as Profile
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -82,6 +84,7 @@ def test_manifest_records_the_settings(recorded):
 @pytest.mark.parametrize("change", [
     dict(seed=5), dict(effects=Effects(table_tilt_deg=2.0)), dict(declare_effects=False), dict(support="hull"),
     dict(velocities=(50.0,)), dict(velocities=(20.0, 50.0)), dict(accelerations=(0.0, 100.0)), dict(repeats=2),
+    dict(testbed=REALISTIC),
 ])
 def test_resume_with_other_settings_is_refused_naming_them(recorded, change):
     before = files(recorded)
@@ -228,8 +231,21 @@ def test_cli_killed_and_resumed_gives_the_files_of_one_run(tmp_path):
     assert files(tmp_path / "killed") == files(tmp_path / "alone")
 
 
+def test_cli_records_a_realistic_testbed_with_overrides(tmp_path):
+    result = run_cli(f"--out_dir={tmp_path}", "--objects=tri1", "--surfaces=delrin", "--velocities=50", "--pushes=1",
+                     "--workers=1", "--testbed=realistic", "--testbed_overrides=drop_rate=0;pusher_friction_sigma=0.5")
+    assert result.returncode == 0, result.stderr
+    settings = json.loads((tmp_path / dataset.MANIFEST_NAME).read_text())["settings"]
+    expected = Profile.from_dict({**REALISTIC.to_dict(), "drop_rate": 0.0, "pusher_friction_sigma": 0.5})
+    assert Profile.from_dict(settings["testbed"]) == expected
+    raw = read_raw_push(next(tmp_path.rglob("*.h5")))
+    assert len(raw.object_pose) == len(raw.tip_pose)  # no dropped samples
+    assert Profile.from_dict(json.loads(raw.attributes["pushjax_testbed"])) == expected
+
+
 @pytest.mark.parametrize("flag, message", [
     ("--objects=cube", "--objects"), ("--velocities=fast", "--velocities"), ("--effects=gravity=1", "--effects"),
+    ("--testbed_overrides=drop_rate=2", "--testbed_overrides"), ("--testbed=lab", "--testbed"),
 ])
 def test_cli_rejects_bad_flags(tmp_path, flag, message):
     result = run_cli(f"--out_dir={tmp_path}", flag)
