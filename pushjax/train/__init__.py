@@ -5,6 +5,7 @@ Modules:
   batching: each model's training subset and seed (`ModelSpec`), its batch order and in-memory batches.
   train_state: `TrainState`, the optimiser and the pure single-model train step.
   sweep_trainer: `sweep`, training K models together (vmapped, unrolled or sequential), resumable.
+  mesh: the sweep's model axis split over a mesh of devices (K/D models per device).
   checkpoint: orbax checkpoints of a (stacked) train state.
   metrics_log: the sweep's ``metrics.csv``.
   losses, evaluate, configs: the training losses, evaluation in the paper's units, configs.
@@ -16,6 +17,7 @@ from pushjax.train import (
     configs,
     evaluate,
     losses,
+    mesh,
     metrics_log,
     sweep_trainer,
     train_state,
@@ -40,6 +42,7 @@ __all__ = [
     "configs",
     "evaluate",
     "losses",
+    "mesh",
     "metrics_log",
     "sweep_trainer",
     "train_state",

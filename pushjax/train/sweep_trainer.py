@@ -11,6 +11,12 @@ convolution, and one model's convolutions already keep both cores busy, so ``seq
 fastest there (``benchmarks/sweep.py``, ``benchmarks/sweep_breakdown.py``). All modes checkpoint
 the same stacked state, so a sweep can resume in another mode.
 
+Devices: with more than one visible device, "vmap" and "unroll" split the model axis over a mesh of
+all of them, at most K (`pushjax.train.mesh`): K models on D devices run K/D per device in the one
+jitted step, the model axis padded to a multiple of D by repeating the last model. Logs, checkpoints
+and the result hold the K models only, on one device, as with a single device, so a sweep resumes on
+any number of devices. "sequential" and a single device run as without a mesh.
+
 Determinism: model k is initialised from ``jax.random.key(spec.seed)`` and draws its batches in an
 order that depends only on its spec and the step (`pushjax.train.batching.batch_indices`), so a sweep
 resumed from a checkpoint replays exactly the batches of an uninterrupted run and ends with the same
@@ -35,8 +41,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import tqdm
+from jax.sharding import Mesh
 
 from pushjax.models import ERROR_OPTIONS, ModelConfig, PushModel
+from pushjax.train import mesh as mesh_lib
 from pushjax.train.batching import Examples, ModelSpec, batch_indices, gather, model_fields
 from pushjax.train.checkpoint import Checkpointer
 from pushjax.train.configs import TrainConfig
@@ -71,7 +79,7 @@ def _unstack(tree: Any, count: int) -> list[Any]:
 @functools.lru_cache(maxsize=16)
 def _compiled_step(
     model_config: ModelConfig, physics: Callable | None, learning_rate: float, weight_decay: float,
-    mode: str, per_model_options: bool,
+    mode: str, per_model_options: bool, mesh: Mesh | None = None,
 ):
     """The jitted train step of one model ("sequential") or of K stacked models ("vmap", "unroll").
 
@@ -84,6 +92,8 @@ def _compiled_step(
       weight_decay: weight of the loss's weight penalty.
       mode: one of `SWEEP_MODES`.
       per_model_options: whether the step takes [K, 2] per-model error-term flags (else None).
+      mesh: for "vmap" and "unroll", the device mesh whose devices each step K/D of the models
+        (arguments and outputs sharded with `mesh_lib.shard`), or None for one device.
     """
     model = PushModel(model_config) if physics is None else PushModel(model_config, physics)
     optimizer = make_optimizer(learning_rate)
@@ -91,7 +101,8 @@ def _compiled_step(
     if mode == "sequential":
         return jax.jit(train_step)
     if mode == "vmap":
-        return jax.jit(jax.vmap(train_step, in_axes=(0, 0, 0 if per_model_options else None)))
+        step = jax.vmap(train_step, in_axes=(0, 0, 0 if per_model_options else None))
+        return jax.jit(step if mesh is None else mesh_lib.map_models(step, mesh))
 
     def unrolled_step(states, batches, error_options):
         count = jax.tree.leaves(states)[0].shape[0]
@@ -104,7 +115,7 @@ def _compiled_step(
         ]
         return _stack([state for state, _ in outputs]), _stack([metrics for _, metrics in outputs])
 
-    return jax.jit(unrolled_step)
+    return jax.jit(unrolled_step if mesh is None else mesh_lib.map_models(unrolled_step, mesh))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -167,9 +178,9 @@ def sweep(
         `train_config.num_steps` is returned as it is, with a warning naming the work directory, its
         step and the requested steps (`SweepResult.steps_trained` says how far the models trained).
         None: no checkpoints, no log.
-      mode: one of `SWEEP_MODES`: "vmap" or "unroll": one jitted step for all K models;
-        "sequential": the jitted single-model step once per model at every step (see the module
-        docstring).
+      mode: one of `SWEEP_MODES`: "vmap" or "unroll": one jitted step for all K models, split
+        over all visible devices when there are several; "sequential": the jitted single-model step
+        once per model at every step, on one device (see the module docstring).
       physics: replaces `PushModel.physics` (default `lynch.predict`).
       progress: show a progress bar with the running loss (mean over models).
       description: the progress bar's label; by default the variants, subset sizes and seeds of `specs`.
@@ -187,9 +198,11 @@ def sweep(
     model = PushModel(model_config) if physics is None else PushModel(model_config, physics)
     optimizer = make_optimizer(train_config.learning_rate)
     options = _error_options(model_config, specs)
+    devices = jax.devices()[:len(specs)]
+    mesh = mesh_lib.model_mesh(devices) if mode != "sequential" and len(devices) > 1 else None
     step_fn = _compiled_step(
         model_config, physics, train_config.learning_rate, train_config.weight_decay, mode,
-        options is not None,
+        options is not None, mesh,
     )
     fields = model_fields(model_config)
     num_examples = len(examples[fields[0]]) if fields[0] in examples else 0
@@ -238,6 +251,18 @@ def sweep(
             return [model_state for model_state, _ in outputs], _stack([metrics for _, metrics in outputs])
 
         models, stacked = _unstack(state, len(specs)), _stack
+    elif mesh is not None:
+        padded = mesh_lib.padded_count(len(specs), mesh)
+        if options is not None:
+            options = mesh_lib.shard(mesh_lib.pad(options, padded), mesh)
+
+        def advance(models, batches):
+            batch = {name: np.stack([b[name] for b in batches]) for name in fields}
+            models, metrics = step_fn(models, mesh_lib.shard(mesh_lib.pad(batch, padded), mesh), options)
+            return models, mesh_lib.unshard(metrics, len(specs), mesh)
+
+        models = mesh_lib.shard(mesh_lib.pad(state, padded), mesh)
+        stacked = functools.partial(mesh_lib.unshard, count=len(specs), mesh=mesh)
     else:
         def advance(models, batches):
             return step_fn(models, {name: np.stack([b[name] for b in batches]) for name in fields}, options)
