@@ -132,11 +132,16 @@ class Effects:
 
     @classmethod
     def _from_mapping(cls, values: dict[str, Any]) -> Effects:
-        known = {field.name for field in dataclasses.fields(cls)}
-        unknown = sorted(set(values) - known)
-        if unknown:
-            raise ValueError(f"effects: unknown effect(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
-        return cls(**values)
+        return from_fields(cls, values, "effects: unknown effect(s)")
+
+
+def from_fields(cls: type, values: dict[str, Any], unknown_message: str):
+    """``cls(**values)`` for a dataclass `cls`, raising ``ValueError(unknown_message ...)`` naming unknown fields."""
+    known = {field.name for field in dataclasses.fields(cls)}
+    unknown = sorted(set(values) - known)
+    if unknown:
+        raise ValueError(f"{unknown_message} {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+    return cls(**values)
 
 
 def parse_assignments(spec: str, what: str) -> dict[str, str]:

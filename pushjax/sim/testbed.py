@@ -70,7 +70,7 @@ from typing import Any
 
 import numpy as np
 
-from pushjax.sim.effects import as_float, parse_assignments
+from pushjax.sim.effects import as_float, from_fields, parse_assignments
 
 FIELD_FEATURES = 64
 """Random Fourier features of each smooth random field."""
@@ -155,11 +155,7 @@ class Testbed:
     @classmethod
     def from_dict(cls, values: dict[str, Any]) -> Testbed:
         """Inverse of :meth:`to_dict`; missing fields take the ideal (off) values, unknown fields are an error."""
-        known = {field.name for field in dataclasses.fields(cls)}
-        unknown = sorted(set(values) - known)
-        if unknown:
-            raise ValueError(f"testbed: unknown field(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
-        return cls(**values)
+        return from_fields(cls, values, "testbed: unknown field(s)")
 
     def with_overrides(self, spec: str) -> Testbed:
         """This profile with the fields of ``name=value;name=value`` replaced (empty string: unchanged)."""
