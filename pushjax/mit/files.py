@@ -492,6 +492,18 @@ class PushIterator:
     ``PushFileError.reason``. Files not ending in ``.h5`` are ignored, and files excluded by the filters are
     counted in ``n_filtered``. ``skipped`` reflects the latest pass; after each (complete or abandoned) pass a
     summary is logged with absl.logging.
+
+    Args:
+      root: dataset root directory, laid out as ``<root>/<surface>/<object>/<file>.h5``.
+      objects: object names to keep (e.g. ``{"rect1"}``), or None for all.
+      surfaces: surface names to keep (e.g. ``{"abs"}``), or None for all.
+      velocities: pusher velocities to keep, mm/s (compared with 1e-6 tolerance), or None for all.
+      accelerations: pusher accelerations to keep, mm/s² (compared with 1e-6 tolerance), or None for all.
+      frequency: rate of each push's common clock, Hz.
+      zero_initial_pose: see ``clean_push``.
+
+    Filters select on the parsed file-name fields. Iterate it for ``Push`` values; ``skipped``, ``n_skipped``,
+    ``n_filtered`` and ``summary()`` report the files not yielded.
     """
 
     def __init__(
@@ -576,31 +588,6 @@ class PushIterator:
         )
 
 
-def iter_pushes(
-    root: str | os.PathLike,
-    objects: Collection[str] | None = None,
-    surfaces: Collection[str] | None = None,
-    velocities: Collection[float] | None = None,
-    accelerations: Collection[float] | None = None,
-    frequency: float = DEFAULT_FREQUENCY,
-    zero_initial_pose: bool = False,
-) -> PushIterator:
-    """The cleaned pushes of every ``*.h5`` file below ``root`` (any depth), in sorted path order.
-
-    Args:
-      root: dataset root directory, laid out as ``<root>/<surface>/<object>/<file>.h5``.
-      objects: object names to keep (e.g. ``{"rect1"}``), or None for all.
-      surfaces: surface names to keep (e.g. ``{"abs"}``), or None for all.
-      velocities: pusher velocities to keep, mm/s (compared with 1e-6 tolerance), or None for all.
-      accelerations: pusher accelerations to keep, mm/s² (compared with 1e-6 tolerance), or None for all.
-      frequency: rate of each push's common clock, Hz.
-      zero_initial_pose: see ``clean_push``.
-
-    Returns:
-      A ``PushIterator``: iterate it for ``Push`` values; its ``skipped``, ``n_skipped``, ``n_filtered`` and
-      ``summary()`` report the files not yielded. Filters select on the parsed file-name fields.
-    """
-    return PushIterator(
-        root, objects=objects, surfaces=surfaces, velocities=velocities, accelerations=accelerations,
-        frequency=frequency, zero_initial_pose=zero_initial_pose,
-    )
+iter_pushes = PushIterator
+"""The cleaned pushes of every ``*.h5`` file below a dataset root (any depth), in sorted path order; see
+:class:`PushIterator` for the arguments and the report of the files not yielded."""
