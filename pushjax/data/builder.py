@@ -10,6 +10,17 @@ per split::
     builder.download_and_prepare()
     sources = tfds.data_source("push_effects/data_efficiency_smoke", data_dir=DIR, download=False)
 
+With Apache Beam instead of the process pool (``pip install 'pushjax[beam]'``), simulation, rendering and writing
+are Beam transforms that any runner can run (TFDS's Beam support: the runner and its options come in the download
+config)::
+
+    builder.download_and_prepare(download_config=tfds.download.DownloadConfig(
+        beam_runner="DirectRunner", beam_options=PipelineOptions(["--direct_num_workers=2"])))
+
+Both paths write the same records in the same order (by key: sequence, then example). The files are the same too
+while TFDS's Beam writer keeps a split in one shard (under 128 MiB); beyond, it cuts more shards than the process
+pool, which fills shards of ``EXAMPLES_PER_SHARD``.
+
 Resuming: a finished dataset is not rebuilt, and the simulated sequences are cached as MIT files under
 ``<data_dir>/push_effects_raw/seed<seed>/`` (shared by all experiments and scales of a seed, since the pushes
 drawn for a smaller scale are a prefix of those of a larger one), so an interrupted build only redoes the
@@ -39,6 +50,8 @@ import tensorflow_datasets as tfds
 import tqdm
 from array_record.python.array_record_module import ArrayRecordWriter
 from tensorflow_datasets.core import example_serializer
+from tensorflow_datasets.core import writer as tfds_writer
+from tensorflow_datasets.proto import tf_example_pb2
 
 from pushjax.data import configs
 from pushjax.data.examples import ALL_FIELDS, make_renderer, sequence_examples
@@ -79,7 +92,9 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
         ``<data_dir>/push_effects_raw/seed<seed>``, where missing sequences are simulated.
       workers: worker processes for simulation and rendering (default: all cores; 1: this process). Workers are
         spawned, so a script that builds with several workers must do so under ``if __name__ == "__main__":``.
-      progress: show a progress bar per split.
+        Not used by a Beam build (a download config with ``beam_runner`` or ``beam_options``), whose runner
+        decides.
+      progress: show a progress bar per split (process-pool builds).
       **kwargs: as for ``tfds.core.GeneratorBasedBuilder`` (``config``, ``data_dir``, ...); the file format
         defaults to ``array_record``.
     """
@@ -136,10 +151,20 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
                         "before the push, pusher position and motion, object motion over the horizon, and the "
                         "ground-truth physical state (Kloss, Schaal & Bohg).",
             features=features,
+            # Stored in key order, as generated (not shuffled): the process pool and Beam write the same order.
+            disable_shuffling=True,
             metadata=tfds.core.MetadataDict(config=dataclasses.asdict(dataset)),
         )
 
     def _generate_splits(self, dl_manager, download_config) -> list[tfds.core.SplitInfo]:
+        if download_config.beam_runner is not None or download_config.beam_options is not None:
+            # TFDS runs the Beam pipeline of `_split_generators` and writes each split with its BeamWriter, which
+            # sorts the examples by key (no shuffling, see `_info`). An in-process runner (the DirectRunner's
+            # default) renders in this process, whose renderers are closed afterwards.
+            try:
+                return super()._generate_splits(dl_manager, download_config)
+            finally:
+                _close_renderers()
         # TFDS's own writer buffers a split in memory and spills beyond 1 GB through tf.io.gfile, i.e. needs
         # TensorFlow; each split is streamed into array_record shards here instead, in generation order.
         if self._workers == 1:
@@ -170,7 +195,7 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
                     shard_lengths.append(0)
                     writer = ArrayRecordWriter(os.fspath(_partial_shard(template, len(shard_lengths) - 1)),
                                                "group_size:1")
-                record = serializer.serialize_example(features.encode_example(example))
+                record = canonical_record(serializer.serialize_example(features.encode_example(example)))
                 writer.write(record)
                 shard_lengths[-1] += 1
                 num_bytes += len(record)
@@ -184,7 +209,11 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
                                              filename_template=template))
         return infos
 
-    def _split_generators(self, dl_manager):
+    def _example_writer(self) -> tfds_writer.ExampleWriter:
+        return _CanonicalExampleWriter(self.info.file_format)
+
+    def _split_generators(self, dl_manager, pipeline=None):
+        """Split name -> (key, example) iterator, or with a Beam ``pipeline`` (given by TFDS) a PCollection."""
         plan = configs.plan_splits(self.builder_config.dataset, self._raw_dir)
         if not self._simulate_missing:
             missing = [job.path for job in plan.jobs if not job.path.is_file()]
@@ -193,6 +222,8 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
                     f"raw_dir: {len(missing)} of {len(plan.jobs)} files planned for {self.builder_config.name} "
                     f"are missing under {self._raw_dir} (first: {missing[0]}); a raw folder you give is read-only "
                     "to pushjax: add the files, or leave raw_dir out to simulate into pushjax's own cache")
+        if pipeline is not None:
+            return _beam_splits(pipeline, self.builder_config.dataset, plan, self._simulate_missing)
         return {name: self._generate_examples(plan, ids, name) for name, ids in plan.splits.items()}
 
     def _generate_examples(self, plan: configs.SplitPlan, ids: tuple[int, ...], split: str) -> Iterator:
@@ -205,9 +236,52 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
             results = _ordered_map(self._pool, sequence_task, tasks, ahead=4 * self._workers)
         with tqdm.tqdm(total=len(tasks), disable=not self._progress, unit="seq", desc=f"{dataset.name} {split}") as bar:
             for sequence_id, examples in zip(ids, results):
-                for k in range(len(examples["sequence_id"])):
-                    yield f"{sequence_id:07d}_{k:04d}", {name: value[k] for name, value in examples.items()}
+                yield from keyed_examples(dataset, sequence_id, examples)
                 bar.update()
+
+
+def _beam_splits(pipeline, dataset: configs.DatasetConfig, plan: configs.SplitPlan, simulate_missing: bool) -> dict:
+    """Split name -> Beam PCollection of (key, example) for TFDS to write.
+
+    Each planned sequence is recorded (or read) and cut into examples once, on whichever worker the runner picks,
+    then goes to every split that holds it (the alternative training splits share sequences).
+    """
+    beam = tfds.core.lazy_imports.apache_beam
+    sequence_ids = sorted(set().union(*plan.splits.values()))
+    sequences = (
+        pipeline
+        | "PlannedSequences" >> beam.Create([(i, plan.jobs[i]) for i in sequence_ids])
+        | "SpreadOverWorkers" >> beam.Reshuffle()  # Create alone may leave every sequence on one worker.
+        | "SimulateOrRead" >> beam.Map(_recorded, simulate_missing=simulate_missing)
+        | "MakeExamples" >> beam.MapTuple(lambda sequence_id, job: (
+            sequence_id, recorded_sequence_examples(dataset, job, sequence_id))))
+    return {
+        name: (sequences
+               | f"Select_{name}" >> beam.Filter(lambda sequence, ids=frozenset(ids): sequence[0] in ids)
+               | f"Key_{name}" >> beam.FlatMap(lambda sequence: keyed_examples(dataset, *sequence)))
+        for name, ids in plan.splits.items()}
+
+
+def _recorded(sequence: tuple[int, PushJob], simulate_missing: bool) -> tuple[int, PushJob]:
+    """(sequence id, recording job), once the job's raw file exists (see :func:`record_missing`)."""
+    record_missing(sequence[1], simulate_missing)
+    return sequence
+
+
+class _CanonicalExampleWriter(tfds_writer.ExampleWriter):
+    """TFDS's shard writer (used by Beam builds), writing :func:`canonical_record` records."""
+
+    def write(self, path, examples):
+        return super().write(path, ((key, canonical_record(record)) for key, record in examples))
+
+
+def canonical_record(record: bytes) -> bytes:
+    """A serialized ``tf.train.Example`` with its features in name order.
+
+    Protobuf writes a map's entries (an example's features) in an order that varies from process to process;
+    sorted, a record's bytes depend only on its content, whichever process serialized it.
+    """
+    return tf_example_pb2.Example.FromString(record).SerializeToString(deterministic=True)
 
 
 def _ordered_map(pool: concurrent.futures.Executor, function, tasks: list, ahead: int) -> Iterator:
@@ -251,6 +325,34 @@ def sequence_rng(dataset: configs.DatasetConfig, job: PushJob) -> np.random.Gene
     return np.random.default_rng([dataset.seed, zlib.crc32(job.path.name.encode("utf-8"))])
 
 
+def keyed_examples(dataset: configs.DatasetConfig, sequence_id: int,
+                   examples: dict[str, np.ndarray]) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
+    """(key, example) of a sequence's stacked examples (field -> [E, ...], E = ``examples_per_sequence``).
+
+    The key, ``sequence_id * E + index``, is the example's place among all examples of the split plan: a split's
+    examples are stored in key order.
+    """
+    first = sequence_id * dataset.examples_per_sequence
+    for index in range(dataset.examples_per_sequence):
+        yield first + index, {name: value[index] for name, value in examples.items()}
+
+
+def record_missing(job: PushJob, simulate_missing: bool) -> None:
+    """Records the sequence's raw file (MuJoCo testbed) unless it exists.
+
+    Args:
+      job: the sequence's recording job.
+      simulate_missing: whether a missing file may be simulated, i.e. the raw folder is pushjax's own cache.
+
+    Raises:
+      IncompleteRawDirError: the raw file is missing from a folder that may not be written.
+    """
+    if not job.path.exists():
+        if not simulate_missing:
+            raise IncompleteRawDirError(f"raw_dir: {job.path} is missing (a raw folder you give is read-only)")
+        record_push(job)
+
+
 def sequence_task(task: tuple[configs.DatasetConfig, PushJob, int, bool]) -> dict[str, np.ndarray]:
     """Worker: reads the sequence's raw file (recording it first if missing and allowed), returns its examples.
 
@@ -262,10 +364,12 @@ def sequence_task(task: tuple[configs.DatasetConfig, PushJob, int, bool]) -> dic
       IncompleteRawDirError: the raw file is missing from a folder that may not be written.
     """
     dataset, job, sequence_id, simulate_missing = task
-    if not job.path.exists():
-        if not simulate_missing:
-            raise IncompleteRawDirError(f"raw_dir: {job.path} is missing (a raw folder you give is read-only)")
-        record_push(job)
+    record_missing(job, simulate_missing)
+    return recorded_sequence_examples(dataset, job, sequence_id)
+
+
+def recorded_sequence_examples(dataset: configs.DatasetConfig, job: PushJob, sequence_id: int) -> dict[str, np.ndarray]:
+    """The examples (field -> [E, ...]) of a sequence whose raw file exists, rendered by this process's renderer."""
     push = load_push(job.path)
     key = (dataset.camera, dataset.image_size, job.params.shape, job.params.surface)
     if key not in _RENDERERS:
@@ -275,11 +379,17 @@ def sequence_task(task: tuple[configs.DatasetConfig, PushJob, int, bool]) -> dic
 
 def build(experiment: str, scale: str = configs.DEFAULT_SCALE, data_dir: str | os.PathLike | None = None,
           seed: int = 0, workers: int | None = None, progress: bool = True,
-          raw_dir: str | os.PathLike | None = None) -> PushEffects:
-    """Builds (or finds) one dataset and returns its builder; see :class:`PushEffects` for the arguments."""
+          raw_dir: str | os.PathLike | None = None, beam_runner=None, beam_options=None) -> PushEffects:
+    """Builds (or finds) one dataset and returns its builder; see :class:`PushEffects` for the arguments.
+
+    ``beam_runner`` (a runner or its name, e.g. ``"DirectRunner"``) and ``beam_options``
+    (``apache_beam.options.pipeline_options.PipelineOptions``) build with Apache Beam instead of the process pool;
+    both None (default): the process pool.
+    """
     builder = PushEffects(config=f"{experiment}_{scale}", data_dir=data_dir, seed=seed, workers=workers,
                           progress=progress, raw_dir=raw_dir)
-    builder.download_and_prepare()
+    builder.download_and_prepare(download_config=tfds.download.DownloadConfig(beam_runner=beam_runner,
+                                                                            beam_options=beam_options))
     return builder
 
 
