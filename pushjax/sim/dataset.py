@@ -40,9 +40,9 @@ from pushjax.mit.files import PushFileError, PushParams, push_file_name, push_fi
 from pushjax.mit.protocol import MIT_ANGLES, MIT_VELOCITIES, sample_push, side_points
 from pushjax.sim import scene
 from pushjax.sim.effects import Effects
-from pushjax.sim.push import simulate_push
+from pushjax.sim.push import Recording, simulate_push
 from pushjax.sim.surfaces import SURFACE_NAMES, get_surface
-from pushjax.sim.testbed import IDEAL, Testbed, draw_conditions
+from pushjax.sim.testbed import IDEAL, PushConditions, Testbed, draw_conditions
 
 _MAX_DRAWS_PER_PUSH = 1000
 """Draws after which a push that keeps hitting already drawn file names gives up."""
@@ -158,22 +158,32 @@ def plan_pushes(
     return jobs
 
 
+def job_conditions(job: PushJob) -> PushConditions | None:
+    """The testbed's draw for a planned push (:func:`pushjax.sim.testbed.draw_conditions`); None if ideal."""
+    if job.testbed.ideal:
+        return None
+    supports = len(scene.support_points(job.params.shape, job.support)[0])
+    return draw_conditions(job.testbed, job.noise_seed[0], job.params.shape, job.params.surface, job.noise_seed,
+                           supports)
+
+
+def simulate_job(job: PushJob) -> Recording:
+    """Simulates one planned push, with its tracking noise and testbed draw, without writing it."""
+    rng = np.random.default_rng(job.noise_seed)
+    return simulate_push(dataclasses.replace(job.params, repetition=None), job.effects, job.support, rng=rng,
+                         conditions=job_conditions(job))
+
+
 def record_push(job: PushJob) -> Path:
-    """Simulates one planned push and writes its file (atomically).
+    """Simulates one planned push (:func:`simulate_job`) and writes its file (atomically).
 
     Under a non-ideal testbed a declaring file also gets ``pushjax_testbed_draw``, the JSON of the push's scalar
     draws (:meth:`pushjax.sim.testbed.PushConditions.draws`).
     """
-    rng = np.random.default_rng(job.noise_seed)
-    conditions, attributes = None, job.attributes
-    if not job.testbed.ideal:
-        supports = len(scene.support_points(job.params.shape, job.support)[0])
-        conditions = draw_conditions(job.testbed, job.noise_seed[0], job.params.shape, job.params.surface,
-                                     job.noise_seed, supports)
-        if attributes is not None:
-            attributes = {**attributes, "pushjax_testbed_draw": json.dumps(conditions.draws(), sort_keys=True)}
-    recording = simulate_push(dataclasses.replace(job.params, repetition=None), job.effects, job.support, rng=rng,
-                              conditions=conditions)
+    attributes = job.attributes
+    if attributes is not None and not job.testbed.ideal:
+        attributes = {**attributes, "pushjax_testbed_draw": json.dumps(job_conditions(job).draws(), sort_keys=True)}
+    recording = simulate_job(job)
     return write_push(job.path, job.params, recording.tip_pose, recording.object_pose, recording.ft_wrench,
                       attributes=attributes)
 

@@ -23,10 +23,13 @@ simulated one. The time step is ``4 ms / n`` with the smallest ``n >= 2`` for wh
 pose, with a zero solver warm start, so a push's result does not depend on the pushes simulated before it.
 
 Testbed (:mod:`pushjax.sim.testbed`): a push simulated with :class:`~pushjax.sim.testbed.PushConditions` is stepped
-one simulation step at a time; before every step the support contacts' coefficients are set from the conditions
-at the support points' current world positions and sliding speeds (load distribution, friction field, speed),
-and the pusher–object coefficient from the push's draw. Without conditions (the ideal testbed) the push runs as a
-single ``mujoco.rollout`` call with the model's fixed coefficients.
+one simulation step at a time. At the start of every 4 ms recording period the support contacts' coefficients are
+set from the conditions: the speed factor at the support points' current sliding speeds, the position factors (load
+distribution, friction field) where the support points are, evaluated again only once a support point has moved
+:data:`FIELD_UPDATE_DISTANCE` (0.5 mm) since their last evaluation (the fields vary over centimetres). The
+pusher–object coefficient comes from the push's draw. The mocap body ``pusher`` (drawn, never in contact) is not
+moved in a stepped push. Without conditions (the ideal testbed) the push runs as a single ``mujoco.rollout`` call
+with the model's fixed coefficients.
 """
 
 from __future__ import annotations
@@ -58,6 +61,9 @@ SETTLE_DURATION = 0.3
 MAX_STEP_TRAVEL = 1e-4
 """Largest pusher advance per simulation step in m."""
 MIN_STEPS_PER_SAMPLE = 2
+FIELD_UPDATE_DISTANCE = 5e-4
+"""Under a testbed, the position-dependent support coefficients are evaluated again once a support point has
+moved this far (m) from where they were last evaluated (the fields vary over centimetres)."""
 
 _PARKED_PUSHER = np.array([1.0, 1.0])
 """Where the pusher waits while the object settles, m (far from every object)."""
@@ -101,6 +107,7 @@ class Simulator:
         self.model = scene.build_model(self.obj, surface, effects, support)
         self.data = mujoco.MjData(self.model)
         self._object_qpos = int(self.model.jnt_qposadr[self.model.joint("object_joint").id])
+        self._object_dof = int(self.model.jnt_dofadr[self.model.joint("object_joint").id])
         self._pusher_qpos = int(self.model.jnt_qposadr[self.model.joint("pusher_x").id])
         self._pusher_qvel = int(self.model.jnt_dofadr[self.model.joint("pusher_x").id])
         self._pusher_z = float(self.model.body("pusher").pos[2])
@@ -197,7 +204,7 @@ class Simulator:
                 initial_warmstart=np.zeros((1, model.nv)))
             qpos_steps, sensors = states[0][:, 1:1 + model.nq], sensors[0]
         else:
-            qpos_steps, sensors = self._stepped(control, conditions)
+            qpos_steps, sensors = self._stepped(control, conditions, steps_per_sample)
 
         # qpos_steps[k] follows step k; prepend the initial state so that index k is time k * timestep.
         qpos_path = np.concatenate([initial_state[None, 1:1 + model.nq], qpos_steps])
@@ -222,10 +229,12 @@ class Simulator:
         return Recording(params=params, tip_pose=tip_pose, object_pose=recorded, ft_wrench=ft_wrench,
                          true_object_pose=true_pose)
 
-    def _stepped(self, control: np.ndarray, conditions: PushConditions) -> tuple[np.ndarray, np.ndarray]:
+    def _stepped(self, control: np.ndarray, conditions: PushConditions,
+                 steps_per_update: int) -> tuple[np.ndarray, np.ndarray]:
         """([nstep, nq] qpos after each step, [nstep, nsensordata] sensors at the state before each step) of the
-        push whose initial state ``self.data`` holds, with the support and pusher coefficients of ``conditions``
-        set before every step (the model's coefficients are restored afterwards)."""
+        push whose initial state ``self.data`` holds, under the coefficients of ``conditions``: the pusher's for
+        the whole push, the supports' set from the object's state every ``steps_per_update`` steps (see the module
+        docstring; the model's coefficients are restored afterwards)."""
         model, data = self.model, self.data
         nominal = model.pair_friction.copy()
         support_nominal = nominal[self._support_pairs, :2]
@@ -233,27 +242,48 @@ class Simulator:
         nstep = len(control)
         qpos_steps = np.empty((nstep, model.nq))
         sensors = np.empty((nstep, model.nsensordata))
-        first = self._object_qpos
-        dof = int(model.jnt_dofadr[model.joint("object_joint").id])
+        ctrl, qpos, sensordata = data.ctrl, data.qpos, data.sensordata
+        pair_friction = model.pair_friction
+        # Any support point is at most this far from the tracked frame's origin (bounds its motion by the pose's).
+        reach = float(np.linalg.norm(self._support_local, axis=1).max())
+        evaluated_at = (math.inf, math.inf, 0.0)  # pose (x m, y m, yaw rad) of the last position factors
         try:
-            model.pair_friction[self._pusher_pairs, :2] = nominal[self._pusher_pairs, :2] * conditions.pusher_friction
-            for k in range(nstep):
-                qpos, qvel = data.qpos, data.qvel
-                yaw = float(_yaw(qpos[first + 3:first + 7][None])[0])
-                offsets = planar.rotate(self._support_local, yaw)
-                points = qpos[first:first + 2] + offsets
-                # Free joint: linear velocity in the world frame, angular velocity in the body frame (plate ~level).
-                velocities = qvel[dof:dof + 2] + qvel[dof + 5] * np.stack([-offsets[:, 1], offsets[:, 0]], axis=1)
-                factors = conditions.support_factors(points, np.linalg.norm(velocities, axis=1), self._support_areas)
-                model.pair_friction[self._support_pairs, :2] = support_nominal * factors[:, None]
-                data.ctrl[:] = control[k, :4]
-                data.mocap_pos[0] = control[k, 4:7]
-                mujoco.mj_step(model, data)
-                qpos_steps[k] = data.qpos
-                sensors[k] = data.sensordata
+            pair_friction[self._pusher_pairs, :2] = nominal[self._pusher_pairs, :2] * conditions.pusher_friction
+            for first_step in range(0, nstep, steps_per_update):
+                pose, speeds = self._support_motion()
+                moved = math.hypot(pose[0] - evaluated_at[0], pose[1] - evaluated_at[1]) + reach * abs(
+                    pose[2] - evaluated_at[2])
+                if moved > FIELD_UPDATE_DISTANCE:
+                    points = planar.rotate(self._support_local, pose[2]) + pose[:2]
+                    position_factors = conditions.position_factors(points, self._support_areas)
+                    evaluated_at = pose
+                factors = position_factors * conditions.speed_factors(speeds)
+                pair_friction[self._support_pairs, :2] = support_nominal * factors[:, None]
+                for k in range(first_step, min(first_step + steps_per_update, nstep)):
+                    ctrl[:] = control[k, :4]
+                    mujoco.mj_step(model, data)
+                    qpos_steps[k] = qpos
+                    sensors[k] = sensordata
         finally:
             model.pair_friction[:] = nominal
         return qpos_steps, sensors
+
+    def _support_motion(self) -> tuple[tuple[float, float, float], np.ndarray]:
+        """(pose (x m, y m, yaw rad) of the tracked frame, [K] sliding speeds of the support points in m/s) in
+        ``self.data``'s state.
+
+        The free joint's linear velocity is in the world frame, its angular velocity in the body frame (the plate
+        is level to within its settling tilt, so the body z axis is the world's); a support point at ``r`` in the
+        body frame slides at ``|R^T v + omega x r|``.
+        """
+        first, dof = self._object_qpos, self._object_dof
+        x, y, _, w, qx, qy, qz = self.data.qpos[first:first + 7].tolist()
+        yaw = math.atan2(2 * (w * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
+        vx, vy, _, _, _, spin = self.data.qvel[dof:dof + 6].tolist()
+        cos, sin = math.cos(yaw), math.sin(yaw)
+        local_x, local_y = self._support_local.T
+        speeds = np.hypot(cos * vx + sin * vy - spin * local_y, cos * vy - sin * vx + spin * local_x)
+        return (x, y, yaw), speeds
 
 
 def _tracked(true_pose: np.ndarray, effects: Effects, rng: np.random.Generator | None) -> np.ndarray:

@@ -16,9 +16,10 @@ from pushjax.geometry.contact import annotate
 from pushjax.mit import protocol
 from pushjax.mit.files import PushParams, load_push, read_raw_push
 from pushjax.physics import lynch
-from pushjax.sim import dataset, scene
+from pushjax.sim import dataset, push, scene
 from pushjax.sim.effects import Effects
 from pushjax.sim.push import SAMPLE_RATE, simulate_push, simulator
+from pushjax.sim.surfaces import SURFACE_NAMES, get_surface
 from pushjax.sim.testbed import IDEAL, REALISTIC, draw_conditions, from_flags
 from pushjax.sim.testbed import Testbed as Profile
 
@@ -104,6 +105,38 @@ def test_friction_field_makes_the_same_push_at_two_places_differ():
     assert abs(field[0] - field[1]) > 1.0 + 5 * abs(uniform[0] - uniform[1]), (uniform, field)
 
 
+def test_four_surfaces_each_with_its_own_friction_field():
+    """The four MIT surfaces have distinct nominal coefficients; each has its own friction field (the realisations
+    are unrelated), with the profile's relative spread over the table on every surface, so the absolute spread of
+    the coefficient over a surface is proportional to the surface's coefficient."""
+    nominal = [get_surface(name).object_friction for name in SURFACE_NAMES]
+    assert SURFACE_NAMES == ("abs", "delrin", "plywood", "pu") and len(set(nominal)) == 4
+    axis = np.linspace(-0.3, 0.3, 50)
+    table = np.stack(np.meshgrid(axis, axis), axis=-1).reshape(-1, 2)
+    log_factors = np.array([np.log(conditions(surface=surface, friction_field_sigma=0.1).position_factors(
+        table, np.ones(len(table)))) for surface in SURFACE_NAMES])
+    np.testing.assert_allclose(log_factors.std(axis=1), 0.1, rtol=0.25)
+    np.testing.assert_allclose(log_factors.mean(axis=1), 0.0, atol=0.03)
+    correlations = np.corrcoef(log_factors)[np.triu_indices(len(SURFACE_NAMES), 1)]
+    assert np.abs(correlations).max() < 0.3, correlations
+
+
+def test_position_factors_evaluated_after_half_a_millimetre_follow_the_object(monkeypatch):
+    """The position factors are evaluated again only once a support point has moved 0.5 mm: the push is then the
+    one that evaluating them at every 4 ms period gives, up to a small part of what freezing them at the start of
+    the push (the object slides 5 cm over fields that vary over 3-5 cm) would change."""
+    p = params(point=0.8)
+    draw = conditions(friction_field_sigma=0.3, pressure_table_sigma=0.7)
+
+    def rotation(distance):
+        monkeypatch.setattr(push, "FIELD_UPDATE_DISTANCE", distance)
+        return np.degrees(motion(simulate_push(p, conditions=draw))[1])
+
+    every_period, lazy, frozen = rotation(0.0), rotation(5e-4), rotation(1.0)
+    assert abs(frozen - every_period) > 0.5, (every_period, frozen)
+    assert abs(lazy - every_period) < 0.1 * abs(frozen - every_period), (every_period, lazy, frozen)
+
+
 def test_plate_pressure_turns_a_central_push():
     """A central push translates rect1 on a uniform pressure (< 1°); on a few high points the centre of friction
     leaves the push line and the plate turns."""
@@ -120,10 +153,9 @@ def test_table_pressure_moves_the_load_with_the_object():
     by millimetres and the limit-surface ratio l by ~15 % between three places."""
     obj = get_object("rect1")
     local, areas = scene.support_points(obj)
-    speeds = np.zeros(len(local))
 
     def centre_and_ratio(draw, shift):
-        weights = areas * draw.support_factors(local + shift, speeds, areas)
+        weights = areas * draw.position_factors(local + shift, areas)
         centre = weights @ local / weights.sum() - obj.centroid
         return centre, limit_surface_ratio(obj, support_points=local, support_weights=weights / weights.mean())
 
@@ -145,7 +177,7 @@ def test_table_pressure_moves_the_load_with_the_object():
 def test_object_friction_scales_the_support_coefficients():
     draw = conditions(obj="tri1", object_friction_sigma=0.2)
     local, areas = scene.support_points("tri1")
-    factors = draw.support_factors(local, np.zeros(len(local)), areas)
+    factors = draw.position_factors(local, areas)
     np.testing.assert_allclose(factors, draw.object_friction)
     assert abs(np.log(draw.object_friction)) > 1e-3
     assert conditions(obj="tri1", surface="pu", object_friction_sigma=0.2).object_friction == draw.object_friction
@@ -156,6 +188,14 @@ def slide_ratio(velocity, draw):
     p = params(velocity=velocity)
     displacement, _ = motion(simulate_push(p, conditions=draw))
     return -displacement[0] / (protocol.PUSH_DISTANCE + protocol.APPROACH_DISTANCE)
+
+
+def test_object_friction_changes_how_far_a_fast_push_slides_on():
+    """The quasi-static model does not depend on the plate–surface coefficient; after a fast push the plate
+    slides on the further, the lower its coefficient."""
+    draw = conditions(object_friction_sigma=0.05)
+    slippery, rough = (slide_ratio(200.0, dataclasses.replace(draw, object_friction=factor)) for factor in (0.8, 1.25))
+    assert slippery > rough + 0.05, (slippery, rough)
 
 
 def test_speed_dependent_friction_changes_fast_pushes_beyond_the_quasi_static_scaling():
@@ -169,9 +209,7 @@ def test_speed_dependent_friction_changes_fast_pushes_beyond_the_quasi_static_sc
     assert slow[0] == pytest.approx(slow[1], abs=0.01)
     assert fast[0] > slow[0] + 0.1  # inertia: sliding on after contact is lost, in both
     assert fast[0] - fast[1] > 0.04, (slow, fast)  # ~ 2.5 mm less sliding on at 200 mm/s
-    draw = conditions(friction_speed_gain=0.1)
-    local, areas = scene.support_points("rect1")
-    factor = [draw.support_factors(local, np.full(len(local), speed), areas)[0] for speed in (0.02, 0.2, 0.0)]
+    factor = conditions(friction_speed_gain=0.1).speed_factors(np.array([0.02, 0.2, 0.0]))
     np.testing.assert_allclose(factor, [1.0, 1.1, 1.0 - 0.1 * np.log10(20)])
 
 
