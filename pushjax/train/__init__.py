@@ -6,6 +6,7 @@ Modules:
   train_state: `TrainState`, the optimiser and the pure single-model train step.
   sweep_trainer: `sweep`, training K models together (vmapped, unrolled or sequential), resumable.
   mesh: the sweep's model axis split over a mesh of devices (K/D models per device).
+  distributed: several processes (hosts) joined to train one sweep.
   checkpoint: orbax checkpoints of a (stacked) train state.
   metrics_log: the sweep's ``metrics.csv``.
   losses, evaluate, configs: the training losses, evaluation in the paper's units, configs.
@@ -15,6 +16,7 @@ from pushjax.train import (
     batching,
     checkpoint,
     configs,
+    distributed,
     evaluate,
     losses,
     mesh,
@@ -40,6 +42,7 @@ __all__ = [
     "batching",
     "checkpoint",
     "configs",
+    "distributed",
     "evaluate",
     "losses",
     "mesh",

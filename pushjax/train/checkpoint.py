@@ -3,6 +3,11 @@
 Orbax writes each step into a temporary folder that it renames when complete, so a run killed while
 saving leaves the previous checkpoint intact; :meth:`Checkpointer.restore_latest` returns the newest
 complete one.
+
+With several processes (`pushjax.train.distributed`) every process calls every method with the same
+arguments; the state is saved from host copies, which orbax writes once (from process 0), so the folder
+must be one that all processes see (a shared file system). A checkpoint restores on any number of
+processes and devices.
 """
 
 from __future__ import annotations
@@ -12,6 +17,7 @@ import os
 from typing import Any
 
 import jax
+import numpy as np
 import orbax.checkpoint as ocp
 from absl import logging as absl_logging
 
@@ -48,11 +54,12 @@ class Checkpointer:
         return self._manager.latest_step()
 
     def save(self, step: int, state: Any, metadata: dict) -> None:
-        """Writes `state` (a pytree of arrays) and JSON-serialisable `metadata` at `step`."""
+        """Writes `state` (a pytree of arrays, the same on every process) and JSON-serialisable `metadata` at `step`."""
         self._manager.save(
             step,
             args=ocp.args.Composite(
-                state=ocp.args.StandardSave(state), metadata=ocp.args.JsonSave(metadata)
+                state=ocp.args.StandardSave(jax.tree.map(np.asarray, state)),
+                metadata=ocp.args.JsonSave(metadata),
             ),
             force=True,
         )

@@ -17,6 +17,12 @@ jitted step, the model axis padded to a multiple of D by repeating the last mode
 and the result hold the K models only, on one device, as with a single device, so a sweep resumes on
 any number of devices. "sequential" and a single device run as without a mesh.
 
+Processes: after `pushjax.train.distributed.initialize`, every process calls `sweep` with the same
+arguments; "vmap" and "unroll" split the model axis over the devices of all processes, each process
+draws the batches of its own models only, and every process gets the K models and their metrics
+(gathered from all). Process 0 writes ``metrics.csv``; orbax writes each checkpoint once. A sweep
+resumes on any number of processes and devices. "sequential" needs one process.
+
 Determinism: model k is initialised from ``jax.random.key(spec.seed)`` and draws its batches in an
 order that depends only on its spec and the step (`pushjax.train.batching.batch_indices`), so a sweep
 resumed from a checkpoint replays exactly the batches of an uninterrupted run and ends with the same
@@ -179,10 +185,11 @@ def sweep(
         step and the requested steps (`SweepResult.steps_trained` says how far the models trained).
         None: no checkpoints, no log.
       mode: one of `SWEEP_MODES`: "vmap" or "unroll": one jitted step for all K models, split
-        over all visible devices when there are several; "sequential": the jitted single-model step
-        once per model at every step, on one device (see the module docstring).
+        over all visible devices when there are several (those of all processes); "sequential": the
+        jitted single-model step once per model at every step, on one device of one process (see the
+        module docstring).
       physics: replaces `PushModel.physics` (default `lynch.predict`).
-      progress: show a progress bar with the running loss (mean over models).
+      progress: show a progress bar with the running loss (mean over models), on process 0.
       description: the progress bar's label; by default the variants, subset sizes and seeds of `specs`.
       step_callback: called after every step with the number of completed steps and
         that step's metrics ({name: [K]} device arrays).
@@ -194,12 +201,14 @@ def sweep(
         raise ValueError("specs: expected at least one model")
     if mode not in SWEEP_MODES:
         raise ValueError(f"mode: expected one of {SWEEP_MODES}, got {mode!r}")
+    if mode == "sequential" and jax.process_count() > 1:
+        raise ValueError(f"mode: 'sequential' trains on one device; with {jax.process_count()} processes use "
+                         "'vmap' or 'unroll'")
     model_config = train_config.model
     model = PushModel(model_config) if physics is None else PushModel(model_config, physics)
     optimizer = make_optimizer(train_config.learning_rate)
     options = _error_options(model_config, specs)
-    devices = jax.devices()[:len(specs)]
-    mesh = mesh_lib.model_mesh(devices) if mode != "sequential" and len(devices) > 1 else None
+    mesh = None if mode == "sequential" else mesh_lib.sweep_mesh(len(specs))
     step_fn = _compiled_step(
         model_config, physics, train_config.learning_rate, train_config.weight_decay, mode,
         options is not None, mesh,
@@ -243,39 +252,42 @@ def sweep(
                     f"workdir: {workdir} holds a checkpoint at step {start}, past the requested num_steps "
                     f"{train_config.num_steps}; the sweep returns the models as trained for {start} steps",
                     stacklevel=2)
-        log = MetricsLog(workdir / "metrics.csv", start)
+        if jax.process_index() == 0:
+            log = MetricsLog(workdir / "metrics.csv", start)
     if mode == "sequential":
         def advance(models, batches):
             outputs = [step_fn(models[k], batches[k], None if options is None else options[k])
                        for k in range(len(specs))]
             return [model_state for model_state, _ in outputs], _stack([metrics for _, metrics in outputs])
 
-        models, stacked = _unstack(state, len(specs)), _stack
+        models, stacked, local_specs = _unstack(state, len(specs)), _stack, specs
     elif mesh is not None:
         padded = mesh_lib.padded_count(len(specs), mesh)
         if options is not None:
-            options = mesh_lib.shard(mesh_lib.pad(options, padded), mesh)
+            options = mesh_lib.shard(mesh_lib.pad(options, padded), padded, mesh)
 
         def advance(models, batches):
             batch = {name: np.stack([b[name] for b in batches]) for name in fields}
-            models, metrics = step_fn(models, mesh_lib.shard(mesh_lib.pad(batch, padded), mesh), options)
+            models, metrics = step_fn(models, mesh_lib.shard(batch, padded, mesh), options)
             return models, mesh_lib.unshard(metrics, len(specs), mesh)
 
-        models = mesh_lib.shard(mesh_lib.pad(state, padded), mesh)
+        models = mesh_lib.shard(mesh_lib.pad(state, padded), padded, mesh)
         stacked = functools.partial(mesh_lib.unshard, count=len(specs), mesh=mesh)
+        # This process's rows of the padded model axis; a padding row repeats the last model.
+        local_specs = [specs[min(row, len(specs) - 1)] for row in mesh_lib.local_rows(padded, mesh)]
     else:
         def advance(models, batches):
             return step_fn(models, {name: np.stack([b[name] for b in batches]) for name in fields}, options)
 
-        models, stacked = state, lambda stacked_state: stacked_state
+        models, stacked, local_specs = state, lambda stacked_state: stacked_state, specs
 
     metrics = None
     with tqdm.tqdm(
-        total=train_config.num_steps, initial=start, disable=not progress,
+        total=train_config.num_steps, initial=start, disable=not progress or jax.process_index() != 0,
         desc=description or describe_specs(model_config.variant, specs),
     ) as bar:
         for step in range(start, train_config.num_steps):
-            models, metrics = advance(models, [batch_at(spec, step) for spec in specs])
+            models, metrics = advance(models, [batch_at(spec, step) for spec in local_specs])
             done = step + 1
             bar.update(1)
             if done % train_config.log_every == 0 or done == train_config.num_steps:

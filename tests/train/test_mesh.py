@@ -65,13 +65,55 @@ def test_pad_shard_and_unshard_round_trip():
     np.testing.assert_array_equal(padded["host"], np.concatenate([tree["host"], [[10, 11], [10, 11]]]))
     np.testing.assert_array_equal(padded["device"], [0, 1, 2, 3, 4, 5, 5, 5])
     assert mesh.pad(tree, 6)["host"] is tree["host"]
-    restored = mesh.unshard(mesh.shard(padded, device_mesh), 6, device_mesh)
+    assert mesh.local_rows(8, device_mesh) == range(8)  # one process holds every row
+    restored = mesh.unshard(mesh.shard(padded, 8, device_mesh), 6, device_mesh)
     jax.tree.map(np.testing.assert_array_equal, restored, jax.tree.map(np.asarray, tree))
 
 
 def _rows(path):
     with path.open() as file:
         return list(csv.DictReader(file))
+
+
+def assert_equals_sequential(examples, workdir, leaves, loss, sequential, sequential_workdir):
+    """A sharded sweep of `CONFIG` against the single-device `sequential` sweep of the same models, to float tolerance.
+
+    Also checks that the sharded sweep's checkpoint resumes in this process, on one device, to the same state.
+
+    Args:
+      examples: the training split both sweeps trained on.
+      workdir: the sharded sweep's work directory (checkpoints, ``metrics.csv``).
+      leaves: its final state, ``jax.tree.leaves``, as NumPy arrays.
+      loss: [K] its last step's losses.
+      sequential: the `SweepResult` of the sequential sweep.
+      sequential_workdir: the sequential sweep's work directory.
+    """
+    specs, reference = sequential.specs, jax.tree.map(np.asarray, sequential.state)
+    state = jax.tree.unflatten(jax.tree.structure(reference), leaves)
+    assert [(a.shape, a.dtype) for a in leaves] == [(a.shape, a.dtype) for a in jax.tree.leaves(reference)]
+    np.testing.assert_array_equal(state.step, [CONFIG.num_steps] * len(specs))
+    # Each device runs a vmapped or unrolled step of its models (vmapped: grouped convolutions), whose float
+    # summation order differs from one model's step; Adam turns rounding differences of near-zero gradients into
+    # differences of up to a step (learning rate 1e-3), hence rtol 1e-3 and atol 1e-4 on the parameters and
+    # batch statistics, as for the vmapped against the sequential sweep in test_sweep_trainer. (Adam's
+    # moments, raw gradient scale, are left out: their rounding differences are not bounded by a step.)
+    jax.tree.map(lambda got, want: np.testing.assert_allclose(got, want, rtol=1e-3, atol=1e-4),
+                 (state.params, state.batch_stats), (reference.params, reference.batch_stats))
+    np.testing.assert_allclose(loss, sequential.final_metrics["loss"], rtol=1e-3)
+    # The models differ (the padding repeats the last one), so the comparison is not trivially true.
+    kernel = jax.tree.leaves(sequential.state.params)[0]
+    assert all(not np.allclose(kernel[k], kernel[k + 1]) for k in range(len(specs) - 1))
+
+    # metrics.csv: the same rows (no padded model), the resumed half appended, values to the same tolerance.
+    rows, want_rows = _rows(Path(workdir) / "metrics.csv"), _rows(Path(sequential_workdir) / "metrics.csv")
+    assert [(r["step"], r["model"], r["name"]) for r in rows] == [(r["step"], r["model"], r["name"]) for r in want_rows]
+    np.testing.assert_allclose([float(r["loss"]) for r in rows], [float(r["loss"]) for r in want_rows], rtol=1e-3)
+
+    # The checkpoint holds the K models only: it resumes on this one device to the same state.
+    restored = train.sweep(CONFIG, examples, specs, workdir, mode="vmap", progress=False)
+    for got, want in zip(jax.tree.leaves(restored.state), leaves):
+        np.testing.assert_array_equal(np.asarray(got), want)
+    np.testing.assert_array_equal(restored.steps_trained, [CONFIG.num_steps] * len(specs))
 
 
 def test_sweep_on_4_devices_equals_the_sequential_sweep_on_one(examples, tmp_path):
@@ -102,29 +144,5 @@ def test_sweep_on_4_devices_equals_the_sequential_sweep_on_one(examples, tmp_pat
     assert [tuple(layout) for layout in sharded["layouts"]] == [(4, 8, 2)], sharded["layouts"]
     assert sharded["result_devices"] == [1]
 
-    reference = jax.tree.map(np.asarray, sequential.state)
-    state = jax.tree.unflatten(jax.tree.structure(reference), sharded_leaves)
-    assert [(a.shape, a.dtype) for a in sharded_leaves] == [(a.shape, a.dtype) for a in jax.tree.leaves(reference)]
-    np.testing.assert_array_equal(state.step, [CONFIG.num_steps] * len(SPECS))
-    # Each device runs a vmapped step of its 2 models (grouped convolutions), whose float summation order
-    # differs from one model's step; Adam turns rounding differences of near-zero gradients into
-    # differences of up to a step (learning rate 1e-3), hence rtol 1e-3 and atol 1e-4 on the parameters and
-    # batch statistics, as for the vmapped against the sequential sweep in test_sweep_trainer. (Adam's
-    # moments, raw gradient scale, are left out: their rounding differences are not bounded by a step.)
-    jax.tree.map(lambda got, want: np.testing.assert_allclose(got, want, rtol=1e-3, atol=1e-4),
-                 (state.params, state.batch_stats), (reference.params, reference.batch_stats))
-    np.testing.assert_allclose(sharded["loss"], sequential.final_metrics["loss"], rtol=1e-3)
-    # The models differ (the padding repeats the last one), so the comparison is not trivially true.
-    kernel = jax.tree.leaves(sequential.state.params)[0]
-    assert all(not np.allclose(kernel[k], kernel[k + 1]) for k in range(len(SPECS) - 1))
-
-    # metrics.csv: the same rows (no padded model), the resumed half appended, values to the same tolerance.
-    rows, want_rows = _rows(tmp_path / "sharded" / "metrics.csv"), _rows(tmp_path / "sequential" / "metrics.csv")
-    assert [(r["step"], r["model"], r["name"]) for r in rows] == [(r["step"], r["model"], r["name"]) for r in want_rows]
-    np.testing.assert_allclose([float(r["loss"]) for r in rows], [float(r["loss"]) for r in want_rows], rtol=1e-3)
-
-    # The checkpoint holds the 6 models only: it resumes on this one device to the same state.
-    restored = train.sweep(CONFIG, examples, SPECS, tmp_path / "sharded", mode="vmap", progress=False)
-    for got, want in zip(jax.tree.leaves(restored.state), sharded_leaves):
-        np.testing.assert_array_equal(np.asarray(got), want)
-    np.testing.assert_array_equal(restored.steps_trained, [CONFIG.num_steps] * len(SPECS))
+    assert_equals_sequential(examples, tmp_path / "sharded", sharded_leaves, sharded["loss"], sequential,
+                             tmp_path / "sequential")
