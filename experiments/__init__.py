@@ -10,6 +10,7 @@ import sys
 from absl import app, flags
 
 from pushjax.paper import paths
+from pushjax.sim import testbed
 
 
 def parse_flags_or_exit(argv: list[str]) -> list[str]:
@@ -38,3 +39,9 @@ def require_writable_folder(flag_name: str) -> None:
         return True
 
     flags.register_validator(flag_name, check)
+
+
+def define_testbed_flag() -> flags.FlagHolder:
+    """Defines ``--testbed`` (``pushjax.sim.testbed.PROFILES``, default ``realistic``) for a binary that records or
+    builds data without the experiments' shared flags (``pushjax.paper.cli`` defines it for those)."""
+    return flags.DEFINE_enum("testbed", testbed.DEFAULT_PROFILE, list(testbed.PROFILES), testbed.FLAG_HELP)

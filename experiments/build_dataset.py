@@ -1,21 +1,23 @@
 r"""Build a push dataset (TFDS, array_record) for one experiment of the paper at one scale.
 
   python -m experiments.build_dataset --experiment=data_efficiency --scale=smoke --data_dir=DIR \
-      [--seed=0] [--workers=N] [--raw_dir=DIR]
+      [--testbed=realistic|ideal] [--seed=0] [--workers=N] [--raw_dir=DIR]
   python -m experiments.build_dataset ... --beam_runner=DirectRunner [--beam_options="--direct_num_workers=2"]
 
 Experiments: data_efficiency, new_pushes, velocities, objects, viewpoint, repeated (``all`` builds each);
-scales: smoke, cpu (default), paper; see ``pushjax.data.configs``. The push sequences are simulated into a raw
-MIT-layout cache (``<data_dir>/push_effects_raw/seed<seed>``), examples are made on all cores and written to
-``<data_dir>/push_effects/<experiment>_<scale>[_seed<seed>]/1.0.0``. ``--raw_dir`` reads the sequences from a
-folder of your own instead (e.g. real MIT files), read-only: it must hold every planned file, else the build
+scales: smoke, cpu (default), paper; see ``pushjax.data.configs``. The push sequences are simulated with the
+``--testbed`` profile (``pushjax.sim.testbed``: ``realistic`` by default, ``ideal`` the clean reference) into a raw
+MIT-layout cache (``<data_dir>/push_effects_raw/<testbed>/seed<seed>``), examples are made on all cores and written
+to ``<data_dir>/push_effects/<experiment>_<scale>[_ideal][_seed<seed>]/2.0.0``. ``--raw_dir`` reads the sequences
+from a folder of your own instead (e.g. real MIT files), read-only: it must hold every planned file, else the build
 stops, counting the missing files and naming the first; nothing is ever written into it. ``--beam_runner``
 simulates, renders and writes with Apache Beam on that runner instead (``pip install 'pushjax[beam]'``), passing it
 ``--beam_options`` as its pipeline options; the records are those of the process pool. Re-running skips finished
-datasets and cached sequences; the same flags give the same bytes. Read the result with
+datasets (the log says which it reused, with version and folder) and cached sequences; the same flags give the same
+bytes. Read the result with
 
   tfds.data_source("push_effects/<experiment>_<scale>", data_dir=DIR)   # after `import pushjax.data.builder`
-  pushjax.data.load("<experiment>", "<scale>", data_dir=DIR)
+  pushjax.data.load("<experiment>", "<scale>", data_dir=DIR)              # testbed="ideal": the ideal profile's
 """
 
 import contextlib
@@ -34,6 +36,7 @@ _EXPERIMENT = flags.DEFINE_enum("experiment", "data_efficiency", [*configs.EXPER
 _SCALE = flags.DEFINE_enum("scale", configs.DEFAULT_SCALE, list(configs.SCALES), "Scale.")
 _DATA_DIR = flags.DEFINE_string("data_dir", None, "TFDS data directory.", required=True)
 _SEED = flags.DEFINE_integer("seed", 0, "Dataset seed.", lower_bound=0)
+_TESTBED = experiments.define_testbed_flag()
 _WORKERS = flags.DEFINE_integer("workers", None, "Worker processes (default: all cores).", lower_bound=1)
 _RAW_DIR = flags.DEFINE_string(
     "raw_dir", None, "Read-only MIT-layout folder holding every planned sequence file (e.g. real MIT files); "
@@ -117,8 +120,8 @@ def main(argv):
     for experiment in names:
         try:
             builder = build(experiment, _SCALE.value, data_dir=_DATA_DIR.value, seed=_SEED.value,
-                            workers=_WORKERS.value, raw_dir=_RAW_DIR.value, beam_runner=_BEAM_RUNNER.value,
-                            beam_options=beam_options)
+                            testbed=_TESTBED.value, workers=_WORKERS.value, raw_dir=_RAW_DIR.value,
+                            beam_runner=_BEAM_RUNNER.value, beam_options=beam_options)
         except IncompleteRawDirError as error:
             raise app.UsageError(f"--{error}") from None
         sizes = ", ".join(f"{name} {split.num_examples}" for name, split in builder.info.splits.items())

@@ -3,7 +3,7 @@ r"""Record simulated MIT Push Dataset files (MuJoCo, MIT protocol and raw layout
   python -m experiments.record_pushes --out_dir=/tmp/pushes --objects=rect1,tri2 --surfaces=abs \
       --velocities=20,50 --pushes=100 --seed=0 [--accelerations=0] [--repeats=1] [--workers=2] \
       [--effects='com_offset=0.01,0.0;table_tilt_deg=1.0'] [--declare_effects=false] [--support=grid] \
-      [--testbed=realistic] [--testbed_overrides='drop_rate=0;friction_field_sigma=0.2']
+      [--testbed=realistic|ideal] [--testbed_overrides='drop_rate=0;friction_field_sigma=0.2']
 
 Pushes are drawn from the MIT grid (side, contact point, angle; velocity and acceleration from the flags) and
 written to ``<out_dir>/<surface>/<object>/motion_surface=..._shape=..._a=..._v=..._i=..._s=..._t=...h5``.
@@ -18,12 +18,12 @@ com_offset=dx,dy (m); pressure_rim=k; friction_anisotropy=kx,ky; table_tilt_deg=
 table_tilt_azimuth_deg=deg; pusher_friction=mu; tracking_noise=sigma_xy,sigma_yaw (m, rad);
 tracking_bias=dx,dy,dyaw (m, m, rad). See ``pushjax.sim.effects`` for what each one does.
 
-``--testbed`` picks the testbed profile of ``pushjax.sim.testbed``: ``ideal`` (every push exactly as Lynch's
-quasi-static model assumes, the default for now) or ``realistic`` (uneven support pressure, friction varying over
-the table, with the object, with the sliding speed and from push to push, and a motion-capture system with noise,
-time-stamp jitter and dropped samples). ``--testbed_overrides`` changes single magnitudes of the profile,
-``name=value`` items separated by ``;`` (0 switches a mechanism off), e.g. ``--testbed=realistic
---testbed_overrides='drop_rate=0;pusher_friction_sigma=0.1'``; the fields are those of
+``--testbed`` picks the testbed profile of ``pushjax.sim.testbed``: ``realistic`` (the default: uneven support
+pressure, friction varying over the table, with the object, with the sliding speed and from push to push, and a
+motion-capture system with noise, time-stamp jitter and dropped samples, calibrated against the paper) or ``ideal``
+(every push exactly as Lynch's quasi-static model assumes, the clean reference). ``--testbed_overrides`` changes
+single magnitudes of the profile, ``name=value`` items separated by ``;`` (0 switches a mechanism off), e.g.
+``--testbed=realistic --testbed_overrides='drop_rate=0;pusher_friction_sigma=0.1'``; the fields are those of
 ``pushjax.sim.testbed.Testbed``.
 """
 
@@ -36,7 +36,7 @@ from pushjax.geometry import OBJECT_NAMES
 from pushjax.sim.dataset import OutDirConflictError, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
-from pushjax.sim.testbed import PROFILES, from_flags
+from pushjax.sim.testbed import from_flags
 
 _OUT_DIR = flags.DEFINE_string("out_dir", None, "Dataset root directory.", required=True)
 _OBJECTS = flags.DEFINE_list("objects", ["rect1"], f"Objects, from {','.join(OBJECT_NAMES)}.")
@@ -50,7 +50,7 @@ _DECLARE = flags.DEFINE_bool("declare_effects", True, "Write effects and seed as
 _REPEATS = flags.DEFINE_integer("repeats", 1, "Files per drawn push (_rep=NNNN when > 1).", lower_bound=1)
 _WORKERS = flags.DEFINE_integer("workers", None, "Worker processes (default: all cores).", lower_bound=1)
 _SUPPORT = flags.DEFINE_enum("support", "grid", ["grid", "hull"], "Support points of the object.")
-_TESTBED = flags.DEFINE_enum("testbed", "ideal", list(PROFILES), "Testbed profile (pushjax.sim.testbed).")
+_TESTBED = experiments.define_testbed_flag()
 _TESTBED_OVERRIDES = flags.DEFINE_string(
     "testbed_overrides", "",
     "Magnitudes of the testbed profile to change, e.g. 'drop_rate=0;friction_field_sigma=0.2'.")

@@ -1,5 +1,6 @@
-"""Test-wide setup: headless MuJoCo rendering and the optional ../shared reference data."""
+"""Test-wide setup: headless MuJoCo rendering, the smoke datasets and the optional ../shared reference data."""
 
+import functools
 import os
 import pathlib
 
@@ -16,3 +17,18 @@ def shared_dir() -> pathlib.Path:
     if not (SHARED / "data").is_dir():
         pytest.skip(f"reference data not found at {SHARED}")
     return SHARED
+
+
+@pytest.fixture(scope="session")
+def smoke_data(tmp_path_factory):
+    """experiment -> the TFDS data directory holding its smoke dataset (built on first request, once per session)."""
+    from pushjax.data import testing
+
+    data_dir = tmp_path_factory.mktemp("smoke_data")
+
+    @functools.cache
+    def build(experiment):
+        testing.smoke_dataset(data_dir, experiment)
+        return data_dir
+
+    return build

@@ -113,6 +113,14 @@ CASES = [
     ("data_efficiency", [*RUN, "--mode=fast"], "--mode"),
     ("data_efficiency", [*RUN, "--variants=transformer"], "--variants"),
     ("data_efficiency", [*RUN, "--variants=,"], "--variants"),
+    ("data_efficiency", [*RUN, "--testbed=perfect"], "--testbed"),
+    ("data_efficiency", [*RUN, "--num_processes=0"], "--num_processes"),
+    ("data_efficiency", [*RUN, "--process_id=-1"], "--process_id"),
+    ("data_efficiency", [*RUN, "--num_processes=2", "--process_id=2", "--coordinator_address=127.0.0.1:1"],
+     "--process_id"),
+    ("data_efficiency", [*RUN, "--num_processes=2"], "--coordinator_address"),
+    ("data_efficiency", [*RUN, "--num_processes=2", "--coordinator_address=localhost"], "--coordinator_address"),
+    ("data_efficiency", [*RUN, "--coordinator_address=127.0.0.1:1234"], "--coordinator_address"),
     ("data_efficiency", [*RUN, "extra"], "unexpected arguments"),
     # Each other experiment binary: the shared flags are wired, and its datasets are looked for.
     *[(binary, [*RUN], "--build") for binary in EXPERIMENTS[1:]],
@@ -138,6 +146,7 @@ CASES = [
     ("build_dataset", ["--data_dir={tmp}/data", "--seed=-1"], "--seed"),
     ("build_dataset", ["--data_dir={tmp}/data", "--workers=0"], "--workers"),
     ("build_dataset", ["--data_dir={tmp}/data", "--raw_dir={tmp}/missing"], "--raw_dir"),
+    ("build_dataset", ["--data_dir={tmp}/data", "--testbed=perfect"], "--testbed"),
     ("build_dataset", ["--data_dir={tmp}/data", "--raw_dir={file}"], "--raw_dir"),
     ("build_dataset", ["--data_dir={tmp}/data", "extra"], "unexpected arguments"),
     # record_pushes

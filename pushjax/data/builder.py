@@ -1,12 +1,14 @@
 """The TFDS builder of the push datasets: array_record files, read back with `tfds.data_source`, no TensorFlow.
 
-One :class:`PushEffects` builder (dataset name ``push_effects``) with a config per experiment and scale, named
-``<experiment>_<scale>`` (see :mod:`pushjax.data.configs`). Building simulates the push sequences the config
-needs (MuJoCo testbed, :mod:`pushjax.sim`) into a raw cache in the MIT layout, cuts them into examples
-(:mod:`pushjax.data.examples`) in worker processes (all cores by default) and writes one array_record file set
-per split::
+One :class:`PushEffects` builder (dataset name ``push_effects``) with a config per experiment, scale and testbed
+profile, named ``<experiment>_<scale>`` on the default ``realistic`` testbed and ``<experiment>_<scale>_ideal`` on
+the ``ideal`` one (see :mod:`pushjax.data.configs`). Building simulates the push sequences the config needs
+(MuJoCo testbed, :mod:`pushjax.sim`, with the config's profile) into a raw cache in the MIT layout, cuts them into
+examples (:mod:`pushjax.data.examples`) in worker processes (all cores by default) and writes one array_record
+file set per split::
 
     builder = PushEffects(config="data_efficiency_smoke", data_dir=DIR)      # seed=3 for another seed
+    # config="data_efficiency_smoke_ideal": the same on the ideal testbed
     builder.download_and_prepare()
     sources = tfds.data_source("push_effects/data_efficiency_smoke", data_dir=DIR, download=False)
 
@@ -21,10 +23,15 @@ Both paths write the same records in the same order (by key: sequence, then exam
 while TFDS's Beam writer keeps a split in one shard (under 128 MiB); beyond, it cuts more shards than the process
 pool, which fills shards of ``EXAMPLES_PER_SHARD``.
 
-Resuming: a finished dataset is not rebuilt, and the simulated sequences are cached as MIT files under
-``<data_dir>/push_effects_raw/seed<seed>/`` (shared by all experiments and scales of a seed, since the pushes
-drawn for a smaller scale are a prefix of those of a larger one), so an interrupted build only redoes the
-examples of the dataset it was writing. The same config and seed give the same bytes.
+Resuming: a finished dataset is not rebuilt (:func:`build` logs that it reused it, with its version and folder),
+and the simulated sequences are cached as MIT files under ``<data_dir>/push_effects_raw/<testbed>/seed<seed>/``
+(shared by all experiments and scales of a testbed and seed, since the pushes drawn for a smaller scale are a
+prefix of those of a larger one; never shared between testbeds), so an interrupted build only redoes the examples
+of the dataset it was writing. The same config and seed give the same bytes.
+
+Versions (``PushEffects.RELEASE_NOTES``): every 1.0.0 dataset and its raw cache ``push_effects_raw/seed<seed>``
+was simulated with the profile now called ``ideal``; 2.0.0 simulates with ``realistic`` by default, and reads
+neither.
 
 A raw folder given by the user (``raw_dir``, e.g. real MIT files) is read-only to pushjax: it must hold every
 file the config plans, else the build stops with :class:`IncompleteRawDirError` before writing anything; only
@@ -48,6 +55,7 @@ from pathlib import Path
 import numpy as np
 import tensorflow_datasets as tfds
 import tqdm
+from absl import logging
 from array_record.python.array_record_module import ArrayRecordWriter
 from tensorflow_datasets.core import example_serializer
 from tensorflow_datasets.core import writer as tfds_writer
@@ -57,6 +65,7 @@ from pushjax.data import configs
 from pushjax.data.examples import ALL_FIELDS, make_renderer, sequence_examples
 from pushjax.mit.files import load_push
 from pushjax.sim.dataset import PushJob, record_push
+from pushjax.sim.testbed import DEFAULT_PROFILE
 
 DATASET_NAME = "push_effects"
 RAW_DIR_NAME = "push_effects_raw"
@@ -77,8 +86,8 @@ class PushEffectsConfig(tfds.core.BuilderConfig):
 def _builder_config(dataset: configs.DatasetConfig) -> PushEffectsConfig:
     return PushEffectsConfig(
         name=dataset.name, dataset=dataset,
-        description=f"{dataset.experiment} experiment at {dataset.scale} scale (seed {dataset.seed}); "
-                    "see pushjax.data.configs.")
+        description=f"{dataset.experiment} experiment at {dataset.scale} scale on the {dataset.testbed} testbed "
+                    f"(seed {dataset.seed}); see pushjax.data.configs.")
 
 
 class PushEffects(tfds.core.GeneratorBasedBuilder):
@@ -89,7 +98,8 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
       raw_dir: root of a raw (MIT layout) folder to read the sequences from, read-only: building raises
         :class:`IncompleteRawDirError` (counting the missing files, naming the first) unless it holds every file
         the config plans, and never writes into it. None (default): pushjax's own cache
-        ``<data_dir>/push_effects_raw/seed<seed>``, where missing sequences are simulated.
+        ``<data_dir>/push_effects_raw/<testbed>/seed<seed>``, where missing sequences are simulated with the
+        config's testbed profile.
       workers: worker processes for simulation and rendering (default: all cores; 1: this process). Workers are
         spawned, so a script that builds with several workers must do so under ``if __name__ == "__main__":``.
         Not used by a Beam build (a download config with ``beam_runner`` or ``beam_options``), whose runner
@@ -99,8 +109,14 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
         defaults to ``array_record``.
     """
 
-    VERSION = tfds.core.Version("1.0.0")
-    RELEASE_NOTES = {"1.0.0": "First release: six experiments at smoke, cpu and paper scale."}
+    VERSION = tfds.core.Version("2.0.0")
+    RELEASE_NOTES = {
+        "1.0.0": "First release: six experiments at smoke, cpu and paper scale.",
+        "2.0.0": "Pushes simulated with the realistic testbed profile (pushjax.sim.testbed, calibrated against the "
+                 "paper) by default; the ideal profile (every 1.0.0 dataset's) as configs <experiment>_<scale>_ideal. "
+                 "Raw cache per profile (push_effects_raw/<testbed>/seed<seed>). Records written with their "
+                 "features in a canonical (name) order, so the same seed gives the same bytes in any process.",
+    }
     BUILDER_CONFIGS = [_builder_config(dataset) for dataset in configs.all_configs()]
     DEFAULT_CONFIG_NAME = f"data_efficiency_{configs.DEFAULT_SCALE}"
 
@@ -121,7 +137,7 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
         kwargs.setdefault("file_format", "array_record")
         super().__init__(**kwargs)
         self._raw_dir = Path(raw_dir) if raw_dir is not None else (
-            Path(self.data_dir).parents[2] / RAW_DIR_NAME / f"seed{seed}")
+            Path(self.data_dir).parents[2] / RAW_DIR_NAME / self.builder_config.dataset.testbed / f"seed{seed}")
         self._simulate_missing = raw_dir is None
         self._workers = workers or os.cpu_count() or 1
         self._progress = progress
@@ -377,33 +393,44 @@ def recorded_sequence_examples(dataset: configs.DatasetConfig, job: PushJob, seq
     return sequence_examples(push, dataset, _RENDERERS[key], sequence_id, sequence_rng(dataset, job))
 
 
+def config_name(experiment: str, scale: str = configs.DEFAULT_SCALE, testbed: str = DEFAULT_PROFILE) -> str:
+    """The builder config of a dataset, seed aside: ``<experiment>_<scale>``, ``_<testbed>`` unless the default."""
+    return configs.get_config(experiment, scale, testbed=testbed).name
+
+
 def build(experiment: str, scale: str = configs.DEFAULT_SCALE, data_dir: str | os.PathLike | None = None,
-          seed: int = 0, workers: int | None = None, progress: bool = True,
+          seed: int = 0, testbed: str = DEFAULT_PROFILE, workers: int | None = None, progress: bool = True,
           raw_dir: str | os.PathLike | None = None, beam_runner=None, beam_options=None) -> PushEffects:
     """Builds (or finds) one dataset and returns its builder; see :class:`PushEffects` for the arguments.
 
-    ``beam_runner`` (a runner or its name, e.g. ``"DirectRunner"``) and ``beam_options``
-    (``apache_beam.options.pipeline_options.PipelineOptions``) build with Apache Beam instead of the process pool;
-    both None (default): the process pool.
+    ``testbed`` names the testbed profile (``pushjax.sim.testbed.PROFILES``). ``beam_runner`` (a runner or its
+    name, e.g. ``"DirectRunner"``) and ``beam_options`` (``apache_beam.options.pipeline_options.PipelineOptions``)
+    build with Apache Beam instead of the process pool; both None (default): the process pool. Logs (absl, INFO)
+    whether it reused a finished dataset or built it, with the dataset's name, version and folder.
     """
-    builder = PushEffects(config=f"{experiment}_{scale}", data_dir=data_dir, seed=seed, workers=workers,
-                          progress=progress, raw_dir=raw_dir)
+    builder = PushEffects(config=config_name(experiment, scale, testbed), data_dir=data_dir, seed=seed,
+                          workers=workers, progress=progress, raw_dir=raw_dir)
+    reused = builder.is_prepared()
     builder.download_and_prepare(download_config=tfds.download.DownloadConfig(beam_runner=beam_runner,
                                                                             beam_options=beam_options))
+    logging.info("dataset %s version %s: %s %s", dataset_name(experiment, scale, seed, testbed), builder.version,
+                 "reused from" if reused else "built in", builder.data_dir)
     return builder
 
 
-def dataset_name(experiment: str, scale: str = configs.DEFAULT_SCALE, seed: int = 0) -> str:
-    """The ``tfds.data_source`` name of a dataset, e.g. ``push_effects/data_efficiency_cpu``."""
-    configs.get_config(experiment, scale, seed)  # validates the names
-    return f"{DATASET_NAME}/{experiment}_{scale}" + (f"/seed={seed}" if seed else "")
+def dataset_name(experiment: str, scale: str = configs.DEFAULT_SCALE, seed: int = 0,
+                 testbed: str = DEFAULT_PROFILE) -> str:
+    """The ``tfds.data_source`` name of a dataset, e.g. ``push_effects/data_efficiency_cpu`` or
+    ``push_effects/data_efficiency_cpu_ideal/seed=3``."""
+    return f"{DATASET_NAME}/{config_name(experiment, scale, testbed)}" + (f"/seed={seed}" if seed else "")
 
 
 def load(experiment: str, scale: str = configs.DEFAULT_SCALE, data_dir: str | os.PathLike | None = None,
-         seed: int = 0, split: str | None = None):
+         seed: int = 0, testbed: str = DEFAULT_PROFILE, split: str | None = None):
     """The built dataset's ``tfds.data_source``: split name -> random-access source (or one source for ``split``).
 
     Each element is a dict of NumPy arrays with the fields of ``pushjax.data.schema.FIELDS`` plus
     ``pushjax.data.examples.EXTRA_FIELDS``. Nothing is built: a missing dataset raises.
     """
-    return tfds.data_source(dataset_name(experiment, scale, seed), data_dir=data_dir, split=split, download=False)
+    return tfds.data_source(dataset_name(experiment, scale, seed, testbed), data_dir=data_dir, split=split,
+                            download=False)

@@ -45,7 +45,11 @@ Scales:
     ``objects`` 35 k per training set, ``viewpoint`` 191 k / 38 k, ``repeated`` 200; 128 x 128 images and
     80 x 80 px glimpses (the paper's glimpse size, which sets the 1.8 M / 2.7 M parameter counts).
 
-All numbers that define a dataset live in :class:`DatasetConfig`; ``get_config(experiment, scale, seed)``
+Testbeds: every dataset is simulated with a testbed profile of :mod:`pushjax.sim.testbed`, ``realistic`` by default
+(the physics Lynch's model leaves out, calibrated against the paper); ``ideal`` (pushes exactly as the model
+assumes) is the clean reference, its datasets named ``<experiment>_<scale>_ideal``.
+
+All numbers that define a dataset live in :class:`DatasetConfig`; ``get_config(experiment, scale, seed, testbed)``
 returns the one used by the builders.
 """
 
@@ -64,6 +68,7 @@ from pushjax.mit.files import PushParams, push_file_path
 from pushjax.mit.protocol import side_points
 from pushjax.sim.dataset import PushJob, plan_pushes
 from pushjax.sim.effects import Effects
+from pushjax.sim.testbed import DEFAULT_PROFILE, PROFILES, Testbed
 
 EXPERIMENTS = ("data_efficiency", "new_pushes", "velocities", "objects", "viewpoint", "repeated")
 SCALES = ("smoke", "cpu", "paper")
@@ -95,6 +100,7 @@ class DatasetConfig:
       experiment: one of :data:`EXPERIMENTS`.
       scale: one of :data:`SCALES`.
       seed: seed of the push draws, splits, windows, scene transforms and pusher displacements.
+      testbed: name of the testbed profile the pushes are simulated with (``pushjax.sim.testbed.PROFILES``).
       image_size: height = width of the depth image, pixels.
       glimpse_size: side of the square glimpse a model cuts around the pusher, pixels (not used to build the
         data; stored so that models read it from the dataset config).
@@ -118,6 +124,7 @@ class DatasetConfig:
     experiment: str
     scale: str
     seed: int = 0
+    testbed: str = DEFAULT_PROFILE
     image_size: int = 64
     glimpse_size: int = 20
     horizon: float = 0.5
@@ -142,6 +149,8 @@ class DatasetConfig:
             raise ValueError(f"scale: expected one of {', '.join(SCALES)}, got {self.scale!r}")
         if self.camera not in ("top_down", "free"):
             raise ValueError(f"camera: expected 'top_down' or 'free', got {self.camera!r}")
+        if self.testbed not in PROFILES:
+            raise ValueError(f"testbed: expected one of {', '.join(PROFILES)}, got {self.testbed!r}")
         if not isinstance(self.seed, int) or self.seed < 0:
             raise ValueError(f"seed: expected an integer >= 0, got {self.seed!r}")
         for name in ("image_size", "glimpse_size", "pushes_per_object", "test_pushes_per_object",
@@ -156,8 +165,15 @@ class DatasetConfig:
 
     @property
     def name(self) -> str:
-        """The TFDS config name: ``<experiment>_<scale>``, with ``_seed<seed>`` for seeds other than 0."""
-        return f"{self.experiment}_{self.scale}" + (f"_seed{self.seed}" if self.seed else "")
+        """The TFDS config name: ``<experiment>_<scale>``, with ``_<testbed>`` for a testbed other than the default
+        and ``_seed<seed>`` for seeds other than 0 (e.g. ``data_efficiency_smoke_ideal_seed3``)."""
+        return (f"{self.experiment}_{self.scale}" + (f"_{self.testbed}" if self.testbed != DEFAULT_PROFILE else "")
+                + (f"_seed{self.seed}" if self.seed else ""))
+
+    @property
+    def testbed_profile(self) -> Testbed:
+        """The magnitudes of the testbed profile :attr:`testbed`."""
+        return PROFILES[self.testbed]
 
     @property
     def examples_per_sequence(self) -> int:
@@ -188,8 +204,9 @@ _EXPERIMENT_SIZES = {
 }
 
 
-def get_config(experiment: str, scale: str = DEFAULT_SCALE, seed: int = 0) -> DatasetConfig:
-    """The configuration of ``experiment`` at ``scale`` (see the module docstring) with ``seed``."""
+def get_config(experiment: str, scale: str = DEFAULT_SCALE, seed: int = 0,
+               testbed: str = DEFAULT_PROFILE) -> DatasetConfig:
+    """The configuration of ``experiment`` at ``scale`` (see the module docstring) with ``seed`` and ``testbed``."""
     if scale not in _SIZES:
         raise ValueError(f"scale: expected one of {', '.join(SCALES)}, got {scale!r}")
     sizes = dict(_SIZES[scale], **_EXPERIMENT_SIZES.get((experiment, scale), {}))
@@ -198,11 +215,13 @@ def get_config(experiment: str, scale: str = DEFAULT_SCALE, seed: int = 0) -> Da
     if experiment == "repeated":
         sizes["windows_per_sequence"] = 1
         sizes["no_contact_fraction"] = 0.0
-    return DatasetConfig(experiment=experiment, scale=scale, seed=seed, **sizes)
+    return DatasetConfig(experiment=experiment, scale=scale, seed=seed, testbed=testbed, **sizes)
 
 
 def all_configs(seed: int = 0) -> list[DatasetConfig]:
-    return [get_config(experiment, scale, seed) for experiment in EXPERIMENTS for scale in SCALES]
+    """Every experiment at every scale on every testbed profile, with ``seed``."""
+    return [get_config(experiment, scale, seed, testbed)
+            for experiment in EXPERIMENTS for scale in SCALES for testbed in PROFILES]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -225,7 +244,8 @@ def _key(*parts) -> list[int]:
 
 def _pool(obj: str, velocity: float, pushes: int, config: DatasetConfig, raw_dir: Path) -> list[PushJob]:
     """The recording jobs of ``pushes`` draws of ``obj`` at ``velocity`` on every configured surface."""
-    return plan_pushes(raw_dir, [obj], list(config.surfaces), pushes, seed=config.seed, velocities=(velocity,))
+    return plan_pushes(raw_dir, [obj], list(config.surfaces), pushes, seed=config.seed, velocities=(velocity,),
+                       testbed=config.testbed_profile)
 
 
 def _split_off(items: list, fraction: float, rng: np.random.Generator) -> tuple[list, list]:
@@ -255,7 +275,7 @@ def plan_splits(config: DatasetConfig, raw_dir: str | Path) -> SplitPlan:
 
     Args:
       config: the dataset.
-      raw_dir: root of the raw (MIT layout) cache of the simulated sequences.
+      raw_dir: root of the raw (MIT layout) cache of the simulated sequences (of ``config.testbed``).
     """
     raw_dir = Path(raw_dir)
     per_split: dict[str, list[PushJob]] = {}  # split name -> recording jobs
@@ -321,7 +341,7 @@ def plan_splits(config: DatasetConfig, raw_dir: str | Path) -> SplitPlan:
     elif experiment == "repeated":
         per_split = {"test": [PushJob(path=raw_path(raw_dir, REPEATED_PUSH), params=REPEATED_PUSH,
                                       effects=Effects(), support="grid", noise_seed=(config.seed,),
-                                      attributes=None)]}
+                                      attributes=None, testbed=config.testbed_profile)]}
 
     by_path = {job.path: job for jobs in per_split.values() for job in jobs}
     paths = sorted(by_path)

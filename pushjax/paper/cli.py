@@ -14,7 +14,8 @@ from absl import app, flags, logging
 
 from pushjax.data import configs as data_configs
 from pushjax.paper import figures, paths, runner, spec as spec_lib, tables, visualize
-from pushjax.train import SWEEP_MODES
+from pushjax.sim import testbed
+from pushjax.train import SWEEP_MODES, distributed
 
 SCALE = flags.DEFINE_enum("scale", data_configs.DEFAULT_SCALE, data_configs.SCALES, "Dataset and training scale.")
 WORKDIR = flags.DEFINE_string("workdir", None, "Output folder: checkpoints, results.json, results.md, figures.")
@@ -26,10 +27,19 @@ BUILD = flags.DEFINE_bool("build", True, "Build the dataset when it is missing."
 WORKERS = flags.DEFINE_integer("workers", None, "Dataset build processes (default: the builder's).")
 MODE = flags.DEFINE_enum("mode", None, SWEEP_MODES, "Sweep batching (default: sequential on CPU, else vmap).")
 VARIANTS_FLAG = flags.DEFINE_list("variants", [], "Models to train and baselines (default: the experiment's).")
+TESTBED = flags.DEFINE_enum("testbed", testbed.DEFAULT_PROFILE, list(testbed.PROFILES), testbed.FLAG_HELP)
+COORDINATOR_ADDRESS = flags.DEFINE_string(
+    "coordinator_address", None, "Several processes (hosts): host:port of process 0, which coordinates them.")
+NUM_PROCESSES = flags.DEFINE_integer("num_processes", 1, "Processes (one per host) that train together.")
+PROCESS_ID = flags.DEFINE_integer("process_id", 0, "This process's index in [0, --num_processes).")
 
 
 def spec_from_flags(setup: spec_lib.Setup) -> spec_lib.ExperimentSpec:
-    """The `ExperimentSpec` of `setup` with the parsed flags; a bad flag raises ``app.UsageError``."""
+    """The `ExperimentSpec` of `setup` with the parsed flags; a bad flag raises ``app.UsageError``.
+
+    With ``--num_processes`` > 1 it first joins the processes (`pushjax.train.distributed.initialize`), before
+    anything touches JAX.
+    """
     if WORKDIR.value is None:
         raise app.UsageError("--workdir is required")
     try:
@@ -37,13 +47,18 @@ def spec_from_flags(setup: spec_lib.Setup) -> spec_lib.ExperimentSpec:
     except ValueError as error:
         raise app.UsageError(f"--workdir={WORKDIR.value}: {error}") from error
     try:
-        return spec_lib.make_spec(
+        distributed.initialize(COORDINATOR_ADDRESS.value, NUM_PROCESSES.value, PROCESS_ID.value)
+        spec = spec_lib.make_spec(
             setup, SCALE.value, models=VARIANTS_FLAG.value, sizes=SIZES.value, seeds=SEEDS.value,
             num_steps=NUM_STEPS.value, data_dir=DATA_DIR.value, build=BUILD.value, workers=WORKERS.value,
-            mode=MODE.value,
+            mode=MODE.value, testbed=TESTBED.value,
         )
     except ValueError as error:
         raise app.UsageError(f"--{error}") from error
+    if spec.mode == "sequential" and NUM_PROCESSES.value > 1:
+        raise app.UsageError(f"--mode: sequential trains on one device; with --num_processes={NUM_PROCESSES.value} "
+                             "pass --mode=vmap or --mode=unroll")
+    return spec
 
 
 def run_spec(spec: spec_lib.ExperimentSpec) -> runner.RunOutcome:
@@ -68,6 +83,8 @@ def main(name: str, argv) -> dict:
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {argv[1:]}")
     outcome = run_spec(spec_from_flags(spec_lib.SETUPS[name]))
+    if not distributed.is_writer():  # process 0 of several writes and prints
+        return outcome.results
     table = tables.write(outcome.results, WORKDIR.value)
     if name == "visualize":
         pngs = [visualize.plot_outcome(outcome, WORKDIR.value)]

@@ -25,7 +25,6 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
-from absl import logging
 
 from pushjax import data
 from pushjax import train as train_lib
@@ -79,14 +78,14 @@ class DatasetUnavailableError(ValueError):
 def load_splits(spec: ExperimentSpec, dataset: data.DatasetConfig, progress: bool = True):
     """split name -> random-access source of `dataset`, built first when the spec allows it and it is missing.
 
-    Logs which dataset (name, version, folder) it reused or built. Raises `DatasetUnavailableError` before building anything when `dataset` is missing and ``spec.build`` is
-    off, or when it is missing and its data directory is not writable.
+    Logs which dataset (name, version, folder) it reused or built (`pushjax.data.build`). Raises
+    `DatasetUnavailableError` before building anything when `dataset` is missing and ``spec.build`` is off, or when
+    it is missing and its data directory is not writable.
     """
-    builder = data.PushEffects(config=f"{dataset.experiment}_{dataset.scale}", data_dir=spec.data_dir,
-                               seed=dataset.seed)
-    name = data.dataset_name(dataset.experiment, dataset.scale, dataset.seed)
-    reused = builder.is_prepared()
-    if not reused:
+    builder = data.PushEffects(config=data.config_name(dataset.experiment, dataset.scale, dataset.testbed),
+                               data_dir=spec.data_dir, seed=dataset.seed)
+    if not builder.is_prepared():
+        name = data.dataset_name(dataset.experiment, dataset.scale, dataset.seed, dataset.testbed)
         if not spec.build:
             raise DatasetUnavailableError(f"build: dataset {name} is not built (looked in {builder.data_dir}) and --nobuild "
                              "forbids building it; --build builds it there")
@@ -95,11 +94,12 @@ def load_splits(spec: ExperimentSpec, dataset: data.DatasetConfig, progress: boo
         except ValueError as error:
             message = f"dataset {name} is not built and cannot be built in {builder.data_dir_root}: {error}"
             raise DatasetUnavailableError(f"data_dir: {message}") from None
+    if train_lib.distributed.is_writer():  # with several processes, process 0 builds and the others wait
         data.build(dataset.experiment, dataset.scale, data_dir=spec.data_dir, seed=dataset.seed,
-                   workers=spec.workers, progress=progress)
-    logging.info("dataset %s version %s: %s %s", name, builder.VERSION, "reused from" if reused else "built in",
-                 builder.data_dir)
-    return data.load(dataset.experiment, dataset.scale, data_dir=spec.data_dir, seed=dataset.seed)
+                   testbed=dataset.testbed, workers=spec.workers, progress=progress)
+    train_lib.distributed.wait_for_all(f"dataset {builder.builder_config.name} ready")
+    return data.load(dataset.experiment, dataset.scale, data_dir=spec.data_dir, seed=dataset.seed,
+                     testbed=dataset.testbed)
 
 
 def _split_sources(splits: Mapping, names: Sequence[str], dataset: data.DatasetConfig) -> list:
@@ -185,7 +185,8 @@ def _baseline_rows(spec: ExperimentSpec, test_sets: Mapping[str, Examples], l_sc
 
 
 def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True) -> RunOutcome:
-    """Trains the spec's variants and evaluates them and its baselines; writes ``<workdir>/results.json``.
+    """Trains the spec's variants and evaluates them and its baselines; writes ``<workdir>/results.json``
+    (process 0 of several, `pushjax.train.distributed`).
 
     Args:
       spec: the run (`pushjax.paper.spec.make_spec`).
@@ -217,6 +218,7 @@ def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True)
             sweeps.append(sweep)
             rows += _trained_rows(spec, sweep, scaled_tests)
     results = {"name": spec.name, "config": spec.to_json(), "rows": [finite_or_none(row) for row in rows]}
-    workdir.mkdir(parents=True, exist_ok=True)
-    (workdir / "results.json").write_text(json.dumps(results, indent=2))
+    if train_lib.distributed.is_writer():
+        workdir.mkdir(parents=True, exist_ok=True)
+        (workdir / "results.json").write_text(json.dumps(results, indent=2))
     return RunOutcome(spec, results, sweeps, test_sets)

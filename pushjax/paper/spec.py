@@ -19,6 +19,7 @@ import jax
 
 from pushjax.data import configs as data_configs
 from pushjax.models import ERROR_OPTIONS, VARIANTS
+from pushjax.sim.testbed import DEFAULT_PROFILE
 from pushjax.paper.baselines import BASELINES, BASELINE_FIELDS
 from pushjax.train import EVALUATION_FIELDS, SWEEP_MODES, TrainConfig, model_fields
 from pushjax.train import configs as train_configs
@@ -152,7 +153,8 @@ class ExperimentSpec:
         train = dataclasses.asdict(self.train)
         del train["model"]["variant"]  # per row
         config = {
-            "experiment": self.dataset.experiment, "scale": self.scale, "variants": list(self.variants),
+            "experiment": self.dataset.experiment, "scale": self.scale, "testbed": self.dataset.testbed,
+            "variants": list(self.variants),
             "baselines": list(self.baselines), "train_splits": list(self.train_splits),
             "test_splits": list(self.test_splits), "sizes": list(self.sizes), "seeds": list(self.seeds),
             "l_scales": list(self.l_scales),
@@ -230,7 +232,7 @@ def make_spec(
     setup: Setup, scale: str = data_configs.DEFAULT_SCALE, *, models: Sequence[str] = (),
     sizes: Sequence[int | str] = (), seeds: Sequence[int | str] = (0,), num_steps: int | None = None,
     data_dir: str | os.PathLike | None = None, build: bool = True, workers: int | None = None,
-    mode: str | None = None,
+    mode: str | None = None, testbed: str = DEFAULT_PROFILE,
 ) -> ExperimentSpec:
     """The `ExperimentSpec` of `setup` with the user's choices; raises ``ValueError`` naming a bad one.
 
@@ -245,6 +247,7 @@ def make_spec(
       build: build a dataset when it is missing.
       workers: dataset build processes (None: the builder's default).
       mode: sweep mode (None: `default_mode`).
+      testbed: the testbed profile the datasets are simulated with (`pushjax.sim.testbed.PROFILES`).
     """
     models = parse_models(models or setup.models)
     sizes = parse_sizes(sizes or setup.sizes)
@@ -257,8 +260,9 @@ def make_spec(
         raise ValueError(f"mode: expected one of {', '.join(SWEEP_MODES)}, got {mode!r}")
     if workers is not None and workers < 1:
         raise ValueError(f"workers: expected a positive integer, got {workers}")
-    dataset = data_configs.get_config(setup.experiment, scale)
-    test_dataset = data_configs.get_config(setup.test_experiment, scale) if setup.test_experiment else dataset
+    dataset = data_configs.get_config(setup.experiment, scale, testbed=testbed)
+    test_dataset = (data_configs.get_config(setup.test_experiment, scale, testbed=testbed) if setup.test_experiment
+                    else dataset)
     train = train_configs.get_config(dataset)
     train = dataclasses.replace(train, num_steps=num_steps or train.num_steps)
     return ExperimentSpec(

@@ -105,7 +105,9 @@ def markdown(results: Mapping) -> str:
     """The paper-style tables of one experiment's results (layout chosen by ``results["name"]``)."""
     name, rows = results["name"], aggregate(results["rows"])
     config = results["config"]
-    title = f"# {name} ({config['experiment']} dataset, {config['scale']} scale, seeds {config['seeds']})\n\n"
+    testbed = config.get("testbed", "ideal")  # results written before testbed profiles existed are ideal's
+    title = (f"# {name} ({config['experiment']} dataset, {config['scale']} scale, {testbed} testbed, "
+             f"seeds {config['seeds']})\n\n")
     trained = [row for row in rows if row["kind"] == "trained"]
     overall = ("trans_percent", "rot_percent", "pos_mm")
     if name == "data_efficiency":

@@ -225,7 +225,8 @@ def record_pushes(
         of a real MIT file.
       support: support mode (``grid`` or ``hull``).
       testbed: the testbed profile (:mod:`pushjax.sim.testbed`; default :data:`~pushjax.sim.testbed.IDEAL`, the
-        files of the ideal testbed are those recorded before testbeds existed).
+        files of the ideal testbed are those recorded before testbeds existed; ``record_pushes --testbed`` and the
+        dataset configs default to the realistic profile).
       workers: worker processes (default: all cores); 1 records in this process.
       progress: show a tqdm progress bar.
 

@@ -218,6 +218,14 @@ REALISTIC = Testbed(
 PROFILES = {"ideal": IDEAL, "realistic": REALISTIC}
 """The named profiles."""
 
+DEFAULT_PROFILE = "realistic"
+"""The profile of every command (``--testbed``) and dataset config unless another is named; ``ideal`` is the clean
+reference. The library's recording functions (``pushjax.sim.dataset``) keep ``IDEAL`` as their default."""
+
+FLAG_HELP = ("Testbed profile of the simulated pushes (pushjax.sim.testbed): realistic (the physics Lynch's model "
+             "leaves out, calibrated against the paper) or ideal (pushes exactly as the model assumes).")
+"""The help text of every command's ``--testbed`` flag."""
+
 
 def from_flags(profile: str, overrides: str = "") -> Testbed:
     """The profile called ``profile`` (``ideal`` or ``realistic``) with ``overrides`` (``name=value;...``).

@@ -15,6 +15,7 @@ Launch (the same command on every host, ``--process_id`` from 0 to N - 1, the ad
 from __future__ import annotations
 
 import jax
+from jax.experimental import multihost_utils
 
 
 def initialize(coordinator_address: str | None = None, num_processes: int = 1, process_id: int = 0) -> None:
@@ -48,3 +49,14 @@ def initialize(coordinator_address: str | None = None, num_processes: int = 1, p
     jax.config.update("jax_cpu_collectives_implementation", "gloo")
     jax.distributed.initialize(coordinator_address=coordinator_address, num_processes=num_processes,
                                process_id=process_id)
+
+
+def is_writer() -> bool:
+    """Whether this process writes the files the processes share (datasets, logs, results): process 0."""
+    return jax.process_index() == 0
+
+
+def wait_for_all(name: str) -> None:
+    """Blocks until every process has reached the point called `name`; with one process it returns at once."""
+    if jax.process_count() > 1:
+        multihost_utils.sync_global_devices(name)

@@ -50,7 +50,7 @@ import tqdm
 from jax.sharding import Mesh
 
 from pushjax.models import ERROR_OPTIONS, ModelConfig, PushModel
-from pushjax.train import mesh as mesh_lib
+from pushjax.train import distributed, mesh as mesh_lib
 from pushjax.train.batching import Examples, ModelSpec, batch_indices, gather, model_fields
 from pushjax.train.checkpoint import Checkpointer
 from pushjax.train.configs import TrainConfig
@@ -252,7 +252,7 @@ def sweep(
                     f"workdir: {workdir} holds a checkpoint at step {start}, past the requested num_steps "
                     f"{train_config.num_steps}; the sweep returns the models as trained for {start} steps",
                     stacklevel=2)
-        if jax.process_index() == 0:
+        if distributed.is_writer():
             log = MetricsLog(workdir / "metrics.csv", start)
     if mode == "sequential":
         def advance(models, batches):
@@ -283,7 +283,7 @@ def sweep(
 
     metrics = None
     with tqdm.tqdm(
-        total=train_config.num_steps, initial=start, disable=not progress or jax.process_index() != 0,
+        total=train_config.num_steps, initial=start, disable=not progress or not distributed.is_writer(),
         desc=description or describe_specs(model_config.variant, specs),
     ) as bar:
         for step in range(start, train_config.num_steps):

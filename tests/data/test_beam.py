@@ -44,7 +44,7 @@ def test_beam_build_has_the_process_pool_records(tmp_path):
     tfds.disable_progress_bar()
     pool = build("objects", "smoke", data_dir=tmp_path / "pool", workers=1, progress=False)
     beam = PushEffects(config="objects_smoke", data_dir=tmp_path / "beam",
-                       raw_dir=tmp_path / "pool" / "push_effects_raw" / "seed0")
+                       raw_dir=tmp_path / "pool" / "push_effects_raw" / "realistic" / "seed0")
     beam.download_and_prepare(download_config=tfds.download.DownloadConfig(beam_runner="DirectRunner", num_shards=2))
     assert max(len(split.shard_lengths) for split in beam.info.splits.values()) == 2
     assert {name: split.num_examples for name, split in pool.info.splits.items()} == {

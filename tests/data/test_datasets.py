@@ -12,7 +12,7 @@ import pytest
 import tensorflow_datasets as tfds
 
 from pushjax.data import configs
-from pushjax.data.builder import IncompleteRawDirError, build, load
+from pushjax.data.builder import IncompleteRawDirError, PushEffects, build, load
 from pushjax.data.examples import ALL_FIELDS
 from pushjax.data.schema import FIELDS
 from pushjax.geometry import OBJECT_NAMES, THICKNESS
@@ -20,27 +20,14 @@ from pushjax.physics import lynch
 from pushjax.render import free_camera, project, top_down_camera
 
 QUASI_STATIC_BOUND = 0.25
-"""Median |predicted - simulated| / median |simulated| of the testbed's quasi-static agreement (tests/sim)."""
+"""Bound on median |predicted - simulated| / median |simulated| of Lynch's model on the true state of the contact
+examples: the ideal testbed's quasi-static agreement (tests/sim); the realistic smoke data measure about 0.12."""
 
 
 @pytest.fixture(scope="session")
-def data_dir(tmp_path_factory):
-    tfds.disable_progress_bar()
-    return tmp_path_factory.mktemp("push_datasets")
-
-
-@pytest.fixture(scope="session")
-def smoke(data_dir):
-    """experiment -> split -> data source, built on first request."""
-    built = {}
-
-    def get(experiment):
-        if experiment not in built:
-            build(experiment, "smoke", data_dir=data_dir, workers=1, progress=False)
-            built[experiment] = load(experiment, "smoke", data_dir=data_dir)
-        return built[experiment]
-
-    return get
+def smoke(smoke_data):
+    """experiment -> split -> data source of the suite's smoke datasets (default testbed), built on first request."""
+    return lambda experiment: load(experiment, "smoke", data_dir=smoke_data(experiment))
 
 
 def _column(source, name):
@@ -139,12 +126,13 @@ def test_velocity_and_object_compositions(smoke):
         assert {OBJECT_NAMES[i] for i in _column(sources[name], "object_id")} == set(objects), name
 
 
-def test_same_seed_gives_same_bytes(smoke, data_dir, tmp_path):
-    smoke("data_efficiency")
+def test_same_seed_gives_same_bytes(smoke_data, tmp_path):
+    data_dir = smoke_data("data_efficiency")
     build("data_efficiency", "smoke", data_dir=tmp_path, workers=2, progress=False,
-          raw_dir=data_dir / "push_effects_raw" / "seed0")
-    first = data_dir / "push_effects" / "data_efficiency_smoke" / "1.0.0"
-    second = tmp_path / "push_effects" / "data_efficiency_smoke" / "1.0.0"
+          raw_dir=data_dir / "push_effects_raw" / "realistic" / "seed0")
+    version = str(PushEffects.VERSION)
+    first = data_dir / "push_effects" / "data_efficiency_smoke" / version
+    second = tmp_path / "push_effects" / "data_efficiency_smoke" / version
     files = sorted(path.name for path in first.glob("*.array_record-*"))
     assert files and files == sorted(path.name for path in second.glob("*.array_record-*"))
     match, mismatch, errors = filecmp.cmpfiles(first, second, files, shallow=False)
@@ -209,8 +197,8 @@ def test_repeated_push_under_scene_transforms(smoke):
     assert np.linalg.norm(recorded[0]) > 1e-3
 
 
-def test_loading_never_imports_tensorflow(smoke, data_dir):
-    smoke("data_efficiency")
+def test_loading_never_imports_tensorflow(smoke_data):
+    data_dir = smoke_data("data_efficiency")
     script = textwrap.dedent(f"""
         import sys
         import pushjax.data as data
@@ -229,14 +217,23 @@ def test_loading_never_imports_tensorflow(smoke, data_dir):
     assert result.returncode == 0 and result.stdout.strip().endswith("ok"), result.stderr[-3000:]
 
 
-def test_cli_builds_a_dataset(tmp_path):
+def test_cli_builds_an_ideal_dataset_beside_the_default_realistic_one(tmp_path):
     result = subprocess.run(
         [sys.executable, "-m", "experiments.build_dataset", "--experiment=repeated", "--scale=smoke",
-         f"--data_dir={tmp_path}", "--workers=1"],
+         f"--data_dir={tmp_path}", "--workers=1", "--testbed=ideal"],
         capture_output=True, text=True, cwd=Path(__file__).resolve().parents[2])
     assert result.returncode == 0, result.stderr[-3000:]
-    assert "repeated_smoke: test 24 examples" in result.stdout
-    assert len(load("repeated", "smoke", data_dir=tmp_path, split="test")) == 24
+    version = str(PushEffects.VERSION)
+    assert f"repeated_smoke_ideal: test 24 examples in {tmp_path}/push_effects/repeated_smoke_ideal/{version}" \
+        in result.stdout
+    assert f"dataset push_effects/repeated_smoke_ideal version {version}: built in " in result.stderr
+    ideal = _all(load("repeated", "smoke", data_dir=tmp_path, testbed="ideal", split="test"))
+    build("repeated", "smoke", data_dir=tmp_path, workers=1, progress=False)
+    realistic = _all(load("repeated", "smoke", data_dir=tmp_path, split="test"))
+    # Each testbed has its own dataset and raw cache; the same push moves the object differently on each.
+    assert {path.parent.name for path in (tmp_path / "push_effects_raw").rglob("*.h5")} == {"rect1"}
+    assert sorted(path.name for path in (tmp_path / "push_effects_raw").iterdir()) == ["ideal", "realistic"]
+    assert len(realistic["motion"]) == 24 and not np.allclose(ideal["motion"], realistic["motion"], atol=1e-4)
 
 
 def test_a_given_raw_dir_is_never_written(tmp_path):
@@ -260,8 +257,12 @@ def test_cli_refuses_an_incomplete_raw_dir(tmp_path):
     assert not list(raw_dir.iterdir())
 
 
-def test_seeded_configs_and_bad_names():
+def test_seeded_configs_testbeds_and_bad_names():
     assert configs.get_config("objects", "paper", seed=3).name == "objects_paper_seed3"
+    assert configs.get_config("objects", "paper").testbed == "realistic"
+    assert configs.get_config("objects", "paper", seed=3, testbed="ideal").name == "objects_paper_ideal_seed3"
+    with pytest.raises(ValueError, match="testbed: expected one of ideal, realistic, got 'lab'"):
+        configs.get_config("data_efficiency", "smoke", testbed="lab")
     with pytest.raises(ValueError, match="experiment"):
         configs.get_config("nope", "smoke")
     with pytest.raises(ValueError, match="scale"):

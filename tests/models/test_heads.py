@@ -63,8 +63,14 @@ def batches():
 
 
 def _init(variant, view, batch):
+    """The model and the shapes of its variables (traced, not computed: `jax.eval_shape`)."""
     model = PushModel(ModelConfig(variant=variant, view=view, **SMALL))
-    return model, model.init(jax.random.key(0), batch, train=False)
+    return model, jax.eval_shape(lambda: model.init(jax.random.key(0), batch, train=False))
+
+
+def _outputs(model, variables, batch):
+    """The shapes of the model's outputs in eval mode (`jax.eval_shape`)."""
+    return jax.eval_shape(lambda variables, batch: model.apply(variables, batch, train=False), variables, batch)
 
 
 @pytest.mark.parametrize("view", VIEWS)
@@ -82,7 +88,7 @@ def test_parameter_tree_keeps_its_module_paths_and_shapes(variant, view, batches
 @pytest.mark.parametrize("variant", VARIANTS)
 def test_outputs_are_the_ones_the_head_declares(variant, view, batches):
     model, variables = _init(variant, view, batches[view])
-    outputs = model.apply(variables, batches[view], train=False)
+    outputs = _outputs(model, variables, batches[view])
     assert frozenset(outputs) == heads.HEADS[variant].output_names(view)
 
 
@@ -126,6 +132,6 @@ def test_a_registered_head_is_a_variant(batches, monkeypatch):
     monkeypatch.setitem(heads.HEADS, "constant", ConstantHead)
     monkeypatch.setattr(config, "VARIANTS", (*VARIANTS, "constant"))
     model, variables = _init("constant", "top_down", batches["top_down"])
-    outputs = model.apply(variables, batches["top_down"], train=False)
+    outputs = _outputs(model, variables, batches["top_down"])
     assert set(variables["params"]) == {"glimpse", "locator"}
     assert frozenset(outputs) == ConstantHead.output_names("top_down") == {"motion", "object_pixel", "object_pos"}

@@ -1,4 +1,4 @@
-"""Smoke datasets and smoke runs of every experiment binary, each made once per session.
+"""Smoke runs of every experiment binary, each made once per session (on the suite's `smoke_data`).
 
 The binary tests check the runs; the notebook tests render them.
 """
@@ -9,7 +9,7 @@ import importlib
 import pytest
 from absl import flags
 
-SMOKE = ("--scale=smoke", "--num_steps=2", "--mode=unroll")
+SMOKE = ("--scale=smoke", "--num_steps=2")
 RUNS = {
     # binary: (datasets it reads, its flags besides SMOKE, --workdir and --data_dir)
     "data_efficiency": (("data_efficiency",), ("--sizes=20,1000000", "--variants=hybrid,neural_dyn,zero,physics")),
@@ -31,24 +31,6 @@ def run_binary(name, *arguments):
         return module.main(["test"])
     finally:
         flags.FLAGS.unparse_flags()
-
-
-@pytest.fixture(scope="session")
-def data_dir(tmp_path_factory):
-    return tmp_path_factory.mktemp("experiment_data")
-
-
-@pytest.fixture(scope="session")
-def smoke_data(data_dir):
-    """experiment -> the data directory holding its smoke dataset (built on first request)."""
-    from pushjax.data import testing
-
-    @functools.cache
-    def build(experiment):
-        testing.smoke_dataset(data_dir, experiment)
-        return data_dir
-
-    return build
 
 
 @pytest.fixture(scope="session")

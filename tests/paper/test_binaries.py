@@ -106,7 +106,7 @@ def test_missing_workdir_is_a_usage_error():
 @pytest.mark.parametrize("binary", ["data_efficiency", "train"])
 def test_nobuild_names_the_missing_dataset_where_it_looked_and_build(tmp_path, binary):
     message = (r"^--build: dataset push_effects/data_efficiency_smoke is not built \(looked in "
-               f"{tmp_path}/push_effects/data_efficiency_smoke/1.0.0" r"\) and --nobuild forbids building it; "
+               f"{tmp_path}/push_effects/data_efficiency_smoke/2.0.0" r"\) and --nobuild forbids building it; "
                "--build builds it there$")
     with pytest.raises(app.UsageError, match=message):
         run_binary(binary, "--scale=smoke", f"--workdir={tmp_path / 'work'}", f"--data_dir={tmp_path}", "--nobuild")

@@ -14,16 +14,16 @@ def test_load_splits_says_which_dataset_it_reused(smoke_data, caplog):
         splits = runner.load_splits(spec, spec.dataset, progress=False)
     assert "train" in splits
     [message] = [record.getMessage() for record in caplog.records if record.getMessage().startswith("dataset push_effects")]
-    assert message.startswith("dataset push_effects/data_efficiency_smoke version 1.0.0: reused from ")
+    assert message.startswith("dataset push_effects/data_efficiency_smoke version 2.0.0: reused from ")
     assert str(data_dir) in message
 
 
 def test_load_splits_says_where_it_built_a_dataset(tmp_path, caplog):
-    spec = spec_lib.make_spec(spec_lib.SETUPS["velocities"], "smoke", data_dir=tmp_path)
+    spec = spec_lib.make_spec(spec_lib.SETUPS["objects"], "smoke", data_dir=tmp_path)
     with caplog.at_level(logging.INFO, logger="absl"):
         runner.load_splits(spec, spec.dataset, progress=False)
     [message] = [record.getMessage() for record in caplog.records if record.getMessage().startswith("dataset push_effects")]
-    assert message.startswith("dataset push_effects/velocities_smoke version 1.0.0: built in ")
+    assert message.startswith("dataset push_effects/objects_smoke version 2.0.0: built in ")
     assert str(tmp_path) in message
 
 

@@ -44,6 +44,14 @@ def test_visualize_tests_on_the_repeated_push():
     assert spec.to_json()["test_dataset"]["experiment"] == "repeated"
 
 
+def test_datasets_are_simulated_on_the_realistic_testbed_unless_ideal_is_chosen():
+    default = spec_lib.make_spec(spec_lib.SETUPS["visualize"], "smoke")
+    assert default.dataset.testbed == default.test_dataset.testbed == default.to_json()["testbed"] == "realistic"
+    ideal = spec_lib.make_spec(spec_lib.SETUPS["visualize"], "smoke", testbed="ideal")
+    assert ideal.dataset == data_configs.get_config("data_efficiency", "smoke", testbed="ideal")
+    assert ideal.test_dataset.name == "repeated_smoke_ideal" and ideal.to_json()["dataset"]["testbed"] == "ideal"
+
+
 def test_l_scaled_models():
     spec = spec_lib.make_spec(spec_lib.SETUPS["error_variants"], "smoke")
     assert spec.runs_at("error_grad", 1.0) and not spec.runs_at("error_grad", 3.0) and spec.runs_at("error", 3.0)
@@ -64,6 +72,7 @@ def test_to_json_is_strict_json_and_keeps_the_variant_per_row():
     (dict(mode="parallel"), "mode"),
     (dict(workers=0), "workers"),
     (dict(data_dir="/nonexistent/pushjax"), "data_dir"),
+    (dict(testbed="lab"), "testbed"),
 ])
 def test_bad_choices_name_what_is_wrong(choices, message):
     with pytest.raises(ValueError, match=f"^{message}: "):

@@ -3,32 +3,26 @@
 import pytest
 
 from pushjax import train
+from pushjax.data import load
 
 FIELDS = ("depth", "point_cloud", *train.MODEL_INPUT_FIELDS, *train.EVALUATION_FIELDS)
 
 
-@pytest.fixture(scope="session")
-def data_dir(tmp_path_factory):
-    return tmp_path_factory.mktemp("data")
-
-
-def _examples(data_dir, experiment):
-    from pushjax.data import testing
-
-    splits = testing.smoke_dataset(data_dir, experiment)
+def _examples(smoke_data, experiment):
+    splits = load(experiment, "smoke", data_dir=smoke_data(experiment))
     return {name: train.examples_from_source(split, FIELDS) for name, split in splits.items()}
 
 
 @pytest.fixture(scope="session")
-def smoke(data_dir):
+def smoke(smoke_data):
     """split -> examples of the smoke ``data_efficiency`` dataset (top-down depth, 64 x 64)."""
-    return _examples(data_dir, "data_efficiency")
+    return _examples(smoke_data, "data_efficiency")
 
 
 @pytest.fixture(scope="session")
-def smoke_viewpoint(data_dir):
+def smoke_viewpoint(smoke_data):
     """split -> examples of the smoke ``viewpoint`` dataset (free camera, point clouds)."""
-    return _examples(data_dir, "viewpoint")
+    return _examples(smoke_data, "viewpoint")
 
 
 @pytest.fixture(scope="module")

@@ -17,8 +17,8 @@ def _run(*arguments):
         flags.FLAGS.unparse_flags()
 
 
-def test_cli_trains_a_sweep_and_writes_results(smoke, data_dir, tmp_path):
-    del smoke  # builds the dataset under data_dir
+def test_cli_trains_a_sweep_and_writes_results(smoke_data, tmp_path):
+    data_dir = smoke_data("data_efficiency")
     results = _run("--variant=hybrid", "--experiment=data_efficiency", "--scale=smoke", f"--workdir={tmp_path}",
                    "--sizes=100,200", "--seeds=0,1", "--num_steps=10", f"--data_dir={data_dir}", "--nobuild")
     rows = results["rows"]

@@ -49,10 +49,11 @@ half = dataclasses.replace(CONFIG, num_steps=CONFIG.num_steps // 2)
 train.sweep(half, examples, SPECS, workdir, mode="unroll", progress=False, step_callback=record_layout)
 result = train.sweep(CONFIG, examples, SPECS, workdir, mode="unroll", progress=False)
 leaves = jax.tree.leaves(result.state)
+distributed.wait_for_all("sweep done")  # returns once both processes got here
 np.savez(f"{out}{process_id}.npz", *[np.asarray(leaf) for leaf in leaves])
 with open(f"{out}{process_id}.json", "w") as file:
     json.dump({"layouts": sorted(set(layouts)), "state_leaves": len(leaves),
-               "loss": result.final_metrics["loss"].tolist(),
+               "loss": result.final_metrics["loss"].tolist(), "writer": distributed.is_writer(),
                "on_own_first_device": all(leaf.devices() == {jax.local_devices()[0]} for leaf in leaves)}, file)
 """
 
@@ -102,6 +103,7 @@ def test_sweep_on_2_processes_equals_the_sequential_sweep_on_one_device(examples
         assert [tuple(layout) for layout in output["layouts"]] == [(4, 2, 4, 1)], output["layouts"]
         assert output["on_own_first_device"]
     assert outputs[0]["loss"] == outputs[1]["loss"]
+    assert [output["writer"] for output in outputs] == [True, False]
     for got, want in zip(*leaves):
         np.testing.assert_array_equal(got, want)
     # metrics.csv has the sequential sweep's rows once (process 0 wrote it), and the checkpoint resumes here, in one
@@ -129,3 +131,5 @@ def test_initialize_rejects_bad_arguments_naming_them(arguments, name):
 def test_initialize_with_one_process_does_nothing():
     distributed.initialize()
     assert jax.process_count() == 1
+    assert distributed.is_writer()
+    distributed.wait_for_all("nothing to wait for")
