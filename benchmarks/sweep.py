@@ -14,10 +14,8 @@ import dataclasses
 import os
 import platform
 import tempfile
-import time
 
 import jax
-import numpy as np
 from absl import app, flags
 
 from pushjax import train
@@ -25,6 +23,7 @@ from pushjax.data import testing
 from pushjax.models import VARIANTS
 from pushjax.data import configs as data_configs
 from pushjax.train.configs import get_config
+from sweep_timing import timed_sweep
 
 _VARIANT = flags.DEFINE_enum("variant", "hybrid", VARIANTS, "Model variant.")
 _SCALE = flags.DEFINE_enum("scale", "smoke", data_configs.SCALES, "Model and optimiser config scale.")
@@ -36,29 +35,12 @@ _DATA_DIR = flags.DEFINE_string(
 )
 
 
-def _timed_sweep(config, examples, specs, mode):
-    """(total seconds, seconds per step of all models after step 10)."""
-    marks = {}
-
-    def mark(step, metrics):
-        if step in (10, config.num_steps):
-            jax.block_until_ready(metrics)
-            marks[step] = time.perf_counter()
-
-    start = time.perf_counter()
+def _timed(config, examples, specs, mode):
+    """`timed_sweep` of one sweep in `mode`, or for "separate" the sums over K one-model sweeps."""
     if mode != "separate":
-        result = train.sweep(config, examples, specs, mode=mode, progress=False, step_callback=mark)
-        jax.block_until_ready(result.state)
-        total = time.perf_counter() - start
-        return total, (marks[config.num_steps] - marks[10]) / (config.num_steps - 10)
-    total, steady = 0.0, 0.0
-    for spec in specs:
-        begin = time.perf_counter()
-        result = train.sweep(config, examples, [spec], mode="unroll", progress=False, step_callback=mark)
-        jax.block_until_ready(result.state)
-        total += time.perf_counter() - begin
-        steady += (marks[config.num_steps] - marks[10]) / (config.num_steps - 10)
-    return total, steady
+        return timed_sweep(config, examples, specs, mode)
+    times = [timed_sweep(config, examples, [spec], "unroll") for spec in specs]
+    return sum(total for total, _ in times), sum(steady for _, steady in times)
 
 
 def main(argv):
@@ -73,7 +55,7 @@ def main(argv):
     )
     # Baseline: K separate one-model runs, as `experiments.train` does for a single model; the step
     # is compiled once and reused (a separate process per run would compile K times).
-    timings = {mode: _timed_sweep(config, examples, specs, mode) for mode in ("separate", *train.SWEEP_MODES)}
+    timings = {mode: _timed(config, examples, specs, mode) for mode in ("separate", *train.SWEEP_MODES)}
     separate_total, separate_step = timings["separate"]
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, jax {jax.__version__}, "
           f"{jax.devices()[0].platform}; variant {_VARIANT.value}, scale {_SCALE.value}, K = {len(specs)} models, "

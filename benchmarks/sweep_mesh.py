@@ -20,7 +20,6 @@ import platform
 import subprocess
 import sys
 import tempfile
-import time
 
 import jax
 from absl import app, flags
@@ -30,6 +29,7 @@ from pushjax.data import configs as data_configs
 from pushjax.data import testing
 from pushjax.models import VARIANTS
 from pushjax.train.configs import get_config
+from sweep_timing import timed_sweep
 
 _DEVICE_COUNTS = flags.DEFINE_list("device_counts", ["1", "2", "4"], "Numbers of CPU devices D to time.")
 _MODES = flags.DEFINE_list("modes", ["vmap", "unroll", "sequential"], "Sweep modes (sequential only at D = 1).")
@@ -44,21 +44,6 @@ _DATA_DIR = flags.DEFINE_string(
 _DEVICES = flags.DEFINE_integer("devices", 0, "Internal: run as the child process that sees this many devices.")
 
 
-def _timed_sweep(config, examples, specs, mode):
-    """(total seconds, seconds per step of all models after step 10)."""
-    marks = {}
-
-    def mark(step, metrics):
-        if step in (10, config.num_steps):
-            jax.block_until_ready(metrics)
-            marks[step] = time.perf_counter()
-
-    start = time.perf_counter()
-    result = train.sweep(config, examples, specs, mode=mode, progress=False, step_callback=mark)
-    jax.block_until_ready(result.state)
-    return time.perf_counter() - start, (marks[config.num_steps] - marks[10]) / (config.num_steps - 10)
-
-
 def _child(devices):
     """Times each mode on this process's `devices` CPU devices; prints {mode: [total s, s per step]} as JSON."""
     if jax.device_count() != devices:
@@ -71,7 +56,7 @@ def _child(devices):
         len(examples["motion"]), [int(s) for s in _SIZES.value], [int(s) for s in _SEEDS.value]
     )
     modes = [mode for mode in _MODES.value if mode != "sequential" or devices == 1]
-    print(json.dumps({mode: _timed_sweep(config, examples, specs, mode) for mode in modes}))
+    print(json.dumps({mode: timed_sweep(config, examples, specs, mode) for mode in modes}))
 
 
 def main(argv):
