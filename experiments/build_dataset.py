@@ -8,7 +8,7 @@ Experiments: data_efficiency, new_pushes, velocities, objects, viewpoint, repeat
 scales: smoke, cpu (default), paper; see ``pushjax.data.configs``. The push sequences are simulated with the
 ``--testbed`` profile (``pushjax.sim.testbed``: ``realistic`` by default, ``ideal`` the clean reference) into a raw
 MIT-layout cache (``<data_dir>/push_effects_raw/<testbed>/seed<seed>``), examples are made on all cores and written
-to ``<data_dir>/push_effects/<experiment>_<scale>[_ideal][_seed<seed>]/2.0.0``. ``--raw_dir`` reads the sequences
+to ``<data_dir>/push_effects/<experiment>_<scale>[_ideal][_seed<seed>]/3.0.0``. ``--raw_dir`` reads the sequences
 from a folder of your own instead (e.g. real MIT files), read-only: it must hold every planned file, else the build
 stops, counting the missing files and naming the first; nothing is ever written into it. ``--beam_runner``
 simulates, renders and writes with Apache Beam on that runner instead (``pip install 'pushjax[beam]'``), passing it

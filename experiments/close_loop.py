@@ -1,12 +1,14 @@
-r"""Close the loop on measured pushes: residual → the missing effect → refit → held-out error before and after.
+r"""Close the loop on measured pushes: residual → the missing effect → refit → test-split error before and after.
 
   python -m experiments.close_loop --data_dir=DIR --workdir=OUT [--horizon=0.5] [--seed=0] \
-      [--heldout_fraction=0.3] [--min_gain=0.1] [--min_strength=0.1] [--steps=300]
+      [--heldout_fraction=0.25] [--min_gain=0] [--min_strength=0.1] [--steps=300]
 
 DIR holds pushes in the raw MIT layout (``<surface>/<object>/motion_surface=...h5``: real MIT files or the
 testbed's, ``python -m experiments.record_pushes``); only the streams and the file-name fields are used.
 Writes ``OUT/report.json``, ``OUT/details.json``, ``OUT/report.md`` and ``OUT/figures/*.png``; see
-:mod:`pushjax.loop`.
+:mod:`pushjax.loop`. Effects are chosen on fit and select push sequences and measured on a test split of
+``--heldout_fraction`` of them. With too few push sequences to select on it stops with one line naming how
+many it found and how many it needs.
 """
 
 import dataclasses
@@ -23,9 +25,10 @@ _DATA_DIR = flags.DEFINE_string("data_dir", None, "Root of the pushes (raw MIT l
 _WORKDIR = flags.DEFINE_string("workdir", None, "Output directory.", required=True)
 _HORIZON = flags.DEFINE_float("horizon", 0.5, "Prediction window in s.", lower_bound=0.0)
 _SEED = flags.DEFINE_integer("seed", 0, "Seed of the split, bootstraps and error term.", lower_bound=0)
-_HELDOUT = flags.DEFINE_float("heldout_fraction", 0.3, "Share of push sequences held out.")
+_HELDOUT = flags.DEFINE_float("heldout_fraction", LoopSettings.test_fraction,
+                              "Share of push sequences in the untouched test split.")
 _MIN_GAIN = flags.DEFINE_float("min_gain", LoopSettings.min_gain,
-                               "Relative held-out error cut an effect must reach at its lower bound.")
+                               "Relative select-split error cut an effect must exceed, on top of being beyond noise.")
 _MIN_STRENGTH = flags.DEFINE_float("min_strength", LoopSettings.min_strength,
                                    "Share of the error a variable's correction must remove to count as structure.")
 _STEPS = flags.DEFINE_integer("steps", FitSettings.steps, "Adam steps per effect fit.", lower_bound=1)
@@ -37,13 +40,14 @@ def main(argv):
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
     if not 0 < _HORIZON.value < math.inf:
         raise app.UsageError(f"--horizon: expected a positive duration in s, got {_HORIZON.value}")
-    if not 0 < _HELDOUT.value < 1:
-        raise app.UsageError(f"--heldout_fraction: expected a fraction in (0, 1), got {_HELDOUT.value}")
+    if not 0 < _HELDOUT.value < 1 - LoopSettings.select_fraction:
+        raise app.UsageError(f"--heldout_fraction: expected a fraction in (0, {1 - LoopSettings.select_fraction:g}), "
+                             f"got {_HELDOUT.value}")
     if not 0 <= _MIN_GAIN.value < 1:
         raise app.UsageError(f"--min_gain: expected a relative error cut in [0, 1), got {_MIN_GAIN.value}")
     if not 0 <= _MIN_STRENGTH.value <= 1:
         raise app.UsageError(f"--min_strength: expected a share of the error in [0, 1], got {_MIN_STRENGTH.value}")
-    settings = LoopSettings(horizon=_HORIZON.value, heldout_fraction=_HELDOUT.value, min_gain=_MIN_GAIN.value,
+    settings = LoopSettings(horizon=_HORIZON.value, test_fraction=_HELDOUT.value, min_gain=_MIN_GAIN.value,
                             min_strength=_MIN_STRENGTH.value,
                             fit=dataclasses.replace(FitSettings(), steps=_STEPS.value))
     try:
@@ -53,7 +57,8 @@ def main(argv):
         if message.startswith("data_dir"):
             message = "--" + message
         raise app.UsageError(message) from None
-    summary = {key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "explained", "fallback")}
+    summary = {key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "explained", "fallback",
+                                            "remaining")}
     print(json.dumps(summary, indent=2))
     print(f"wrote report.json, details.json, report.md and figures/ to {_WORKDIR.value}")
 

@@ -1,4 +1,5 @@
-r"""Fig. 6: neural, hybrid and error trained at 20, 10 + 20 and 20 + 50 mm/s, tested at 10 to 300 mm/s.
+r"""Fig. 6: neural, neural_dyn, simple, hybrid and error trained at 20, 10 + 20 and 20 + 50 mm/s, tested at 10 to
+300 mm/s.
 
   python -m experiments.velocities [--scale=smoke|cpu|paper] --workdir=DIR
 

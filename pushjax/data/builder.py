@@ -109,13 +109,15 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
         defaults to ``array_record``.
     """
 
-    VERSION = tfds.core.Version("2.0.0")
+    VERSION = tfds.core.Version("3.0.0")
     RELEASE_NOTES = {
         "1.0.0": "First release: six experiments at smoke, cpu and paper scale.",
         "2.0.0": "Pushes simulated with the realistic testbed profile (pushjax.sim.testbed, calibrated against the "
                  "paper) by default; the ideal profile (every 1.0.0 dataset's) as configs <experiment>_<scale>_ideal. "
                  "Raw cache per profile (push_effects_raw/<testbed>/seed<seed>). Records written with their "
                  "features in a canonical (name) order, so the same seed gives the same bytes in any process.",
+        "3.0.0": "data_efficiency and viewpoint gain a validation split (test_pushes_per_object further sequences per "
+                 "object), for learning curves and the choice of the training schedule.",
     }
     BUILDER_CONFIGS = [_builder_config(dataset) for dataset in configs.all_configs()]
     DEFAULT_CONFIG_NAME = f"data_efficiency_{configs.DEFAULT_SCALE}"

@@ -10,8 +10,10 @@ of sequences and take an equal share from each of their velocities or objects.
 
 Experiments (split names in brackets):
 
-``data_efficiency`` [train, test]
-    All 11 objects at 20 mm/s on abs, a random 5/6 : 1/6 split of each object's sequences.
+``data_efficiency`` [train, validation, test]
+    All 11 objects at 20 mm/s on abs, a random 5/6 : 1/6 split of each object's sequences into train and test,
+    and ``test_pushes_per_object`` further sequences per object for validation (learning curves and the choice of
+    the training schedule; never reported as a result).
 ``new_pushes`` [train, validation, test]
     The same sequences; test holds every push at the angles 0° and ±20° and every push at a held-out tenth of
     each object's contact points (side, point); the rest is split 5/6 : 1/6 into train and validation.
@@ -22,7 +24,7 @@ Experiments (split names in brackets):
 test_triangles]
     Training on butter, butter + hex, and butter + hex + ellip1 or tri1; tests on all ellipses and on all
     triangles (for ellip1 and tri1 on sequences kept out of training).
-``viewpoint`` [train, test]
+``viewpoint`` [train, validation, test]
     As ``data_efficiency``, seen by the free (oblique) camera; examples carry the organised point cloud.
 ``repeated`` [test]
     One push configuration (``REPEATED_PUSH``) seen under many scene transforms, for the visual figures.
@@ -108,7 +110,8 @@ class DatasetConfig:
       camera: ``"top_down"`` or ``"free"`` (see :mod:`pushjax.render.camera`).
       surfaces: surfaces of the recorded pushes.
       pushes_per_object: sequences per object and velocity in pools that feed training splits.
-      test_pushes_per_object: sequences per object and velocity in pools that only feed test splits.
+      test_pushes_per_object: sequences per object and velocity in pools that only feed test splits (and the
+        validation splits of ``data_efficiency`` and ``viewpoint``).
       windows_per_sequence: random window start times drawn per sequence.
       transforms_per_window: random scene transforms per window.
       no_contact_fraction: share of examples whose pusher is moved so that it does not touch the object.
@@ -280,26 +283,29 @@ def plan_splits(config: DatasetConfig, raw_dir: str | Path) -> SplitPlan:
     raw_dir = Path(raw_dir)
     per_split: dict[str, list[PushJob]] = {}  # split name -> recording jobs
     experiment = config.experiment
-    if experiment in ("data_efficiency", "viewpoint", "new_pushes"):
-        per_split = {"train": [], "test": []} if experiment != "new_pushes" else {
-            "train": [], "validation": [], "test": []}
+    if experiment in ("data_efficiency", "viewpoint"):
+        per_split = {"train": [], "validation": [], "test": []}
+        for obj in OBJECT_NAMES:
+            pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object + config.test_pushes_per_object, config, raw_dir)
+            rng = np.random.default_rng(_key(config.seed, obj, experiment, "split"))
+            pool, validation = _split_off(pool, config.test_pushes_per_object / len(pool), rng)
+            train, test = _split_off(pool, config.test_fraction, rng)
+            for name, jobs in (("train", train), ("validation", validation), ("test", test)):
+                per_split[name] += jobs
+    elif experiment == "new_pushes":
+        per_split = {"train": [], "validation": [], "test": []}
+        held_angles = np.radians(NEW_PUSH_TEST_ANGLES_DEG)
         for obj in OBJECT_NAMES:
             pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object, config, raw_dir)
             rng = np.random.default_rng(_key(config.seed, obj, experiment, "split"))
-            if experiment == "new_pushes":
-                held_points = held_out_contact_points(obj, config)
-                held_angles = np.radians(NEW_PUSH_TEST_ANGLES_DEG)
-                is_test = [bool(np.any(np.abs(held_angles - job.params.angle) < 1e-3))
-                           or contact_point_id(job.params) in held_points for job in pool]
-                per_split["test"] += [job for job, test in zip(pool, is_test) if test]
-                rest = [job for job, test in zip(pool, is_test) if not test]
-                train, validation = _split_off(rest, config.validation_fraction, rng)
-                per_split["train"] += train
-                per_split["validation"] += validation
-            else:
-                train, test = _split_off(pool, config.test_fraction, rng)
-                per_split["train"] += train
-                per_split["test"] += test
+            held_points = held_out_contact_points(obj, config)
+            is_test = [bool(np.any(np.abs(held_angles - job.params.angle) < 1e-3))
+                       or contact_point_id(job.params) in held_points for job in pool]
+            per_split["test"] += [job for job, test in zip(pool, is_test) if test]
+            train, validation = _split_off([job for job, test in zip(pool, is_test) if not test],
+                                           config.validation_fraction, rng)
+            per_split["train"] += train
+            per_split["validation"] += validation
     elif experiment == "velocities":
         train_pools: dict[float, dict[str, list]] = {}
         for velocity in TEST_VELOCITIES:

@@ -1,11 +1,14 @@
-"""Fallback: a learned error-correction term on top of the (augmented) analytical model.
+"""Fallback: a learned, probabilistic error-correction term on top of the (augmented) analytical model.
 
 Like the ``error`` variant of Kloss et al., a small MLP maps the model's inputs to a correction that is
-added to the model's prediction. Everything is expressed in the object frame (the inputs turned by
-``-object_yaw``, the correction turned back), so the term does not have to learn the symmetry of the
-table plane. The last layer starts at zero, so the untrained term is "no correction". It is trained
-with Adam on the same loss as the effects (:mod:`pushjax.loop.fit`) and early-stopped on a fifth of
-the fit push sequences.
+added to the model's prediction; here it predicts a distribution, not a point: a mean correction and a
+variance per output (heteroscedastic, in the spirit of the heteroscedastic GP of Bauza & Rodriguez 2017
+on the MIT data): the mean is trained on the same robust loss as the effects (:mod:`pushjax.loop.fit`), the
+variance by the Gaussian negative log-likelihood of the mean's error. Everything is expressed in the object
+frame (the inputs turned by ``-object_yaw``, the correction turned back), so the term does not have to
+learn the symmetry of the table plane. The last layer starts at zero, so the untrained term is "no
+correction" with unit variance in units of the ``zero`` baseline. It is trained with Adam and
+early-stopped on the loss of a fifth of the fit push sequences.
 """
 
 from __future__ import annotations
@@ -26,8 +29,13 @@ from pushjax.loop.fit import PAD_MULTIPLE, zero_scales
 from pushjax.loop.windows import Examples, split_by_sequence
 
 
+LOG_VARIANCE_RANGE = (-12.0, 6.0)
+"""Clip of the predicted log variances (units of the zero baseline squared)."""
+
+
 class ErrorTerm(nn.Module):
-    """MLP from standardised features [..., F] to a correction [..., 3] in units of the zero baseline."""
+    """MLP from standardised features [..., F] to the mean correction [..., :3] and its log variance
+    [..., 3:] per output, in units of the zero baseline."""
 
     hidden: Sequence[int] = (64, 64)
 
@@ -36,7 +44,7 @@ class ErrorTerm(nn.Module):
         x = features
         for width in self.hidden:
             x = nn.gelu(nn.Dense(width)(x))
-        return nn.Dense(3, kernel_init=nn.initializers.zeros)(x)
+        return nn.Dense(6, kernel_init=nn.initializers.zeros)(x)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -68,11 +76,19 @@ class ErrorCorrection:
     scales: tuple[float, float]
     hidden: tuple[int, ...]
 
-    def __call__(self, examples: Examples, prediction: np.ndarray) -> np.ndarray:
-        """[N, 3] corrected predictions of the model's [N, 3] ``prediction`` on ``examples``."""
+    def __call__(self, examples: Examples, prediction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The predictive distribution given the model's [N, 3] ``prediction`` on ``examples``.
+
+        Returns:
+          ([N, 3] mean: the corrected prediction, world axes (m, m, rad); [N, 3] standard deviation along
+          the object's axes and of the rotation (m, m, rad)).
+        """
         features = (_features(examples, prediction) - self.mean) / self.std
-        correction = np.asarray(ErrorTerm(self.hidden).apply({"params": self.params}, jnp.asarray(features, jnp.float32)))
-        return _add(examples, prediction, correction, self.scales)
+        output = np.asarray(ErrorTerm(self.hidden).apply({"params": self.params}, jnp.asarray(features, jnp.float32)),
+                            np.float64)
+        units = np.array([self.scales[0], self.scales[0], self.scales[1]])
+        std = np.exp(0.5 * np.clip(output[:, 3:], *LOG_VARIANCE_RANGE)) * units
+        return _add(examples, prediction, output[:, :3], self.scales), std
 
 
 def _features(examples: Examples, prediction: np.ndarray) -> np.ndarray:
@@ -125,8 +141,14 @@ def fit_error_correction(
 
 
 def _window_loss(model, params, x, y):
-    error = model.apply({"params": params}, x) - y
-    return jnp.sqrt(jnp.sum(error[:, :2] ** 2, axis=-1) + 1e-4) + jnp.sqrt(error[:, 2] ** 2 + 1e-4)
+    """The mean's robust error (the effects' loss) plus the Gaussian negative log-likelihood of the variance
+    given the mean (the mean's gradient stopped there, so a large variance does not stall the mean)."""
+    output = model.apply({"params": params}, x)
+    error = output[:, :3] - y
+    log_variance = jnp.clip(output[:, 3:], *LOG_VARIANCE_RANGE)
+    robust = jnp.sqrt(jnp.sum(error[:, :2] ** 2, axis=-1) + 1e-4) + jnp.sqrt(error[:, 2] ** 2 + 1e-4)
+    likelihood = 0.5 * jnp.sum(jax.lax.stop_gradient(error) ** 2 * jnp.exp(-log_variance) + log_variance, axis=-1)
+    return robust + likelihood
 
 
 @functools.partial(jax.jit, static_argnames="settings")

@@ -1,14 +1,21 @@
 """Prediction errors as in Kloss et al.: translation (mm) and rotation (deg), absolute and as % of the
-``zero`` baseline (predicting no motion), with a bootstrap over push sequences.
+``zero`` baseline (predicting no motion); their noise over push sequences (bootstrap intervals, a paired
+sign-flip test) and the scores of a predicted distribution (negative log density, interval coverage).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import itertools
 
 import numpy as np
+from scipy import stats
+
+from pushjax import planar
 
 METRIC_KEYS = ("trans_pct", "rot_pct", "trans_mm", "rot_deg")
+EXACT_FLIPS_UP_TO = 13
+"""Sign-flip tests over at most this many sequences enumerate every sign pattern (2^13 = 8192)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -42,6 +49,12 @@ def window_errors(prediction: np.ndarray, target: np.ndarray, sequence: np.ndarr
     )
 
 
+def concatenate(parts: list[WindowErrors]) -> WindowErrors:
+    """The windows of several :class:`WindowErrors` (e.g. of cross-fitting folds) in order."""
+    return WindowErrors(**{field.name: np.concatenate([getattr(part, field.name) for part in parts])
+                           for field in dataclasses.fields(WindowErrors)})
+
+
 def summarize(errors: WindowErrors) -> dict[str, float]:
     """{trans_pct, rot_pct, trans_mm, rot_deg}: mean errors, and their ratio to the zero baseline's in %."""
     return {
@@ -57,21 +70,108 @@ def combined(summary: dict[str, float]) -> float:
     return summary["trans_pct"] + summary["rot_pct"]
 
 
-def bootstrap_combined(errors: list[WindowErrors], n_bootstrap: int = 1000, seed: int = 0) -> np.ndarray:
-    """[B, M] combined scores of M models (same windows) on B resamplings of the push sequences.
-
-    Sequences are drawn with replacement (counts from a multinomial), the same draws for every model,
-    so differences between models are paired.
-    """
-    sequence = errors[0].sequence
+def _resampling_counts(sequence: np.ndarray, n_bootstrap: int, seed: int):
+    """([B, S] multinomial counts of the S sequences, the per-sequence sum of any [N] values)."""
     ids, index = np.unique(sequence, return_inverse=True)
 
     def per_sequence(values):
         return np.bincount(index, weights=values, minlength=len(ids))
 
     counts = np.random.default_rng(seed).multinomial(len(ids), np.full(len(ids), 1 / len(ids)), size=n_bootstrap)
+    return counts, per_sequence
+
+
+def bootstrap_combined(errors: list[WindowErrors], n_bootstrap: int = 1000, seed: int = 0) -> np.ndarray:
+    """[B, M] combined scores of M models (same windows) on B resamplings of the push sequences.
+
+    Sequences are drawn with replacement (counts from a multinomial), the same draws for every model,
+    so differences between models are paired.
+    """
+    counts, per_sequence = _resampling_counts(errors[0].sequence, n_bootstrap, seed)
     zero_t = counts @ per_sequence(errors[0].zero_translation_mm)
     zero_r = counts @ per_sequence(errors[0].zero_rotation_deg)
     scores = [100 * (counts @ per_sequence(e.translation_mm)) / np.maximum(zero_t, 1e-12)
               + 100 * (counts @ per_sequence(e.rotation_deg)) / np.maximum(zero_r, 1e-12) for e in errors]
     return np.stack(scores, axis=1)
+
+
+def bootstrap_interval(errors: WindowErrors, n_bootstrap: int = 1000, seed: int = 0,
+                       level: float = 0.95) -> dict[str, list[float]]:
+    """{metric: [low, high]}: percentile bootstrap interval (push sequences resampled) of each of
+    :data:`METRIC_KEYS` at the two-sided ``level``."""
+    counts, per_sequence = _resampling_counts(errors.sequence, n_bootstrap, seed)
+    windows = counts @ per_sequence(np.ones(len(errors.sequence)))
+    resampled = {
+        "trans_pct": 100 * (counts @ per_sequence(errors.translation_mm))
+        / np.maximum(counts @ per_sequence(errors.zero_translation_mm), 1e-12),
+        "rot_pct": 100 * (counts @ per_sequence(errors.rotation_deg))
+        / np.maximum(counts @ per_sequence(errors.zero_rotation_deg), 1e-12),
+        "trans_mm": (counts @ per_sequence(errors.translation_mm)) / windows,
+        "rot_deg": (counts @ per_sequence(errors.rotation_deg)) / windows,
+    }
+    tail = (1 - level) / 2
+    return {key: [float(np.quantile(resampled[key], tail)), float(np.quantile(resampled[key], 1 - tail))]
+            for key in METRIC_KEYS}
+
+
+def sequence_gains(reference: WindowErrors, others: list[WindowErrors]) -> np.ndarray:
+    """[M, S] how much each push sequence lowers the combined score (points of %) from ``reference`` to
+    each of M other models on the same windows; row sums are the score differences."""
+    ids, index = np.unique(reference.sequence, return_inverse=True)
+    zero_t = max(reference.zero_translation_mm.sum(), 1e-12)
+    zero_r = max(reference.zero_rotation_deg.sum(), 1e-12)
+
+    def contributions(errors):
+        return (100 * np.bincount(index, errors.translation_mm, len(ids)) / zero_t
+                + 100 * np.bincount(index, errors.rotation_deg, len(ids)) / zero_r)
+
+    base = contributions(reference)
+    return np.stack([base - contributions(other) for other in others]) if others else np.zeros((0, len(ids)))
+
+
+def sign_flip_pvalues(gains: np.ndarray, n_flips: int = 10000, seed: int = 0) -> np.ndarray:
+    """[M] one-sided p-values that the [M, S] per-sequence ``gains`` sum to more than chance would give.
+
+    The paired randomization test over push sequences: under the null hypothesis each sequence's gain is
+    as likely negative as positive, so the sum is compared with its value under every sign pattern
+    (all 2^S when S <= :data:`EXACT_FLIPS_UP_TO`, else ``n_flips`` random ones plus the observed one).
+    The smallest p-value S sequences can give is 2^-S.
+    """
+    gains = np.atleast_2d(np.asarray(gains, np.float64))
+    count = gains.shape[1]
+    if count <= EXACT_FLIPS_UP_TO:
+        signs = np.array(list(itertools.product((1.0, -1.0), repeat=count))).reshape(-1, count)
+        flipped = signs @ gains.T
+        return np.mean(flipped >= gains.sum(axis=1) - 1e-12, axis=0)
+    signs = np.random.default_rng(seed).choice((1.0, -1.0), size=(n_flips, count))
+    flipped = signs @ gains.T
+    return (1 + np.sum(flipped >= gains.sum(axis=1) - 1e-12, axis=0)) / (1 + n_flips)
+
+
+def smallest_pvalue(n_sequences: int, n_flips: int = 10000) -> float:
+    """The smallest p-value :func:`sign_flip_pvalues` can give over ``n_sequences`` sequences."""
+    return 2.0 ** -n_sequences if n_sequences <= EXACT_FLIPS_UP_TO else 1 / (1 + n_flips)
+
+
+def predictive_scores(mean: np.ndarray, std: np.ndarray, target: np.ndarray, yaw: np.ndarray) -> dict[str, float]:
+    """Scores of Gaussian predictive distributions on [N, 3] targets (dx m, dy m, dtheta rad).
+
+    Args:
+      mean: [N, 3] predicted means, world axes (m, m, rad).
+      std: [N, 3] predicted standard deviations along the object's axes and of the rotation (m, m, rad);
+        the three outputs are independent.
+      target: [N, 3] measured motions, world axes.
+      yaw: [N] object orientation, rad (the axes of ``std``).
+
+    Returns:
+      {"nlpd": mean negative log predictive density per window (translation in mm, rotation in deg),
+      "coverage_68", "coverage_95": shares of the outputs inside their central 68 % and 95 % intervals}.
+    """
+    residual = np.asarray(target, np.float64) - np.asarray(mean, np.float64)
+    local = np.column_stack([planar.rotate(residual[:, :2], -np.asarray(yaw, np.float64)), residual[:, 2]])
+    units = np.array([1e3, 1e3, np.degrees(1.0)])
+    z = local / np.asarray(std, np.float64)
+    log_density = stats.norm.logpdf(z) - np.log(np.asarray(std, np.float64) * units)
+    return {"nlpd": float(-np.mean(log_density.sum(axis=1))),
+            "coverage_68": float(np.mean(np.abs(z) <= stats.norm.ppf(0.84))),
+            "coverage_95": float(np.mean(np.abs(z) <= stats.norm.ppf(0.975)))}

@@ -1,22 +1,31 @@
-"""The whole loop on a directory of pushes: examples → baseline → diagnosis → effects → report."""
+"""The whole loop on a directory of pushes: examples → split → diagnosis → effects → fallback → report.
+
+:func:`decide` makes every decision (which effects, whether anything remains) from the fit and select
+sequences only; :func:`close_loop` then refits on the pool, measures on the untouched test split and writes
+the report.
+"""
 
 from __future__ import annotations
 
 import dataclasses
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import tqdm
 
+from pushjax import planar
 from pushjax.loop import correction as correction_lib
 from pushjax.loop import diagnose as diagnose_lib
 from pushjax.loop import fit as fit_lib
 from pushjax.loop import metrics
 from pushjax.loop import report as report_lib
 from pushjax.loop import select as select_lib
-from pushjax.loop.windows import NOMINAL_PUSHER_FRICTION, build_examples, split_by_sequence
+from pushjax.loop import splits as splits_lib
+from pushjax.loop.windows import NOMINAL_PUSHER_FRICTION, Examples, build_examples
 from pushjax.mit.files import iter_pushes
+from pushjax.physics.effects import EFFECT_NAMES
 
 
 @dataclasses.dataclass(frozen=True)
@@ -26,11 +35,14 @@ class LoopSettings:
     Attributes:
       horizon: prediction window, s.
       stride: time between window starts, s (default ``horizon / 2``).
-      heldout_fraction: share of push sequences held out.
+      test_fraction: share of push sequences in the untouched test split.
+      select_fraction: share of push sequences in the select split (when not cross-fitted).
       pusher_friction: nominal pusher-object friction coefficient.
-      min_gain: relative held-out error cut an effect must reach at its lower bound to be selected.
+      effects: candidate library effects.
+      min_gain: relative selection-error cut an effect's point estimate must exceed to be selected (on top
+        of being beyond noise).
       min_strength: share of the error a variable's correction must remove to count as structure.
-      alpha: family-wise error level of the selection and diagnosis decisions.
+      alpha: family-wise error level of the selection, fallback and diagnosis decisions.
       n_bootstrap: bootstrap resamplings of push sequences.
       fit: optimiser settings of the effect fits.
       correction: training settings of the fallback error term.
@@ -38,14 +50,102 @@ class LoopSettings:
 
     horizon: float = 0.5
     stride: float | None = None
-    heldout_fraction: float = 0.3
+    test_fraction: float = splits_lib.TEST_FRACTION
+    select_fraction: float = splits_lib.SELECT_FRACTION
     pusher_friction: float = NOMINAL_PUSHER_FRICTION
+    effects: tuple[str, ...] = EFFECT_NAMES
     min_gain: float = select_lib.MIN_GAIN
     min_strength: float = diagnose_lib.MIN_STRENGTH
     alpha: float = 0.05
     n_bootstrap: int = 1000
     fit: fit_lib.FitSettings = fit_lib.FitSettings()
     correction: correction_lib.CorrectionSettings = correction_lib.CorrectionSettings()
+
+
+@dataclasses.dataclass(frozen=True)
+class Decision:
+    """What the fit and select sequences decided (see :func:`decide`).
+
+    Attributes:
+      split: the roles of the sequences.
+      selection: ranking, rounds and the selected model.
+      fallback_gain: relative selection-error cut of the learned error term over the selected model.
+      fallback_p_value: its one-sided sign-flip p-value.
+      variables: the candidate variables (those that vary).
+      diagnosis_before: the plain model's residual on the pool against the variables.
+      diagnosis_after: the selected model's out-of-fold residual on the selection windows.
+      noise: [3] standard deviation of that residual along the object's axes and of the rotation (m, m, rad).
+      alpha: the level of the fallback's test.
+    """
+
+    split: splits_lib.Split
+    selection: select_lib.Selection
+    fallback_gain: float
+    fallback_p_value: float
+    variables: list[str]
+    diagnosis_before: list[diagnose_lib.Dependence]
+    diagnosis_after: list[diagnose_lib.Dependence]
+    noise: np.ndarray
+    alpha: float
+
+    @property
+    def fallback_helps(self) -> bool:
+        """Whether the learned error term lowers the selection error beyond noise."""
+        return self.fallback_p_value <= self.alpha and self.fallback_gain > 0
+
+    @property
+    def remaining(self) -> list[diagnose_lib.Dependence]:
+        """The variables the selected model's residual still depends on beyond noise."""
+        return [d for d in self.diagnosis_after if d.beyond_noise]
+
+    @property
+    def explained(self) -> bool:
+        """Nothing (no further effect, not the fallback, no variable) improves on the selected model beyond noise."""
+        return not self.fallback_helps and not self.remaining
+
+
+def decide(examples: Examples, settings: LoopSettings = LoopSettings(), seed: int = 0,
+           progress: Callable[[str], None] | None = None) -> Decision:
+    """Splits the windows, selects effects and tests the fallback and the diagnosis, all without the test split.
+
+    Args:
+      examples: the windows of every push.
+      settings: the loop's settings.
+      seed: seed of the split, the tests, the cross-fitting folds and the error terms.
+      progress: called with a short message before each stage.
+
+    Raises:
+      ValueError: too few push sequences (see :func:`pushjax.loop.splits.split`).
+    """
+    report = progress or (lambda message: None)
+    split = splits_lib.split(examples, len(settings.effects), settings.alpha, settings.test_fraction,
+                             settings.select_fraction, seed)
+    diagnose = dict(min_strength=settings.min_strength, n_bootstrap=settings.n_bootstrap, alpha=settings.alpha,
+                    seed=seed)
+    variables = [name for name, values in split.pool.variables.items() if len(np.unique(values)) > 1]
+    report("diagnosing the plain model")
+    before = diagnose_lib.diagnose(split.pool, fit_lib.predict([None], split.pool)[0], variables, **diagnose)
+    selection = select_lib.select_effects(split, settings.effects, settings.fit, settings.min_gain, settings.alpha,
+                                          seed, report)
+    final = selection.final
+    report("fitting the learned error term on each fold")
+    means = []
+    for k, (fit_index, select_index) in enumerate(split.folds):
+        fit, select = split.pool.select(fit_index), split.pool.select(select_index)
+        result = final.fits[k]
+        term = correction_lib.fit_error_correction(fit, fit_lib.predict([result], fit)[0], settings.correction, seed)
+        means.append(term(select, fit_lib.predict([result], select)[0])[0])
+    selection_windows = split.pool.select(split.select_index)
+    fallback = metrics.window_errors(np.concatenate(means), selection_windows.target, selection_windows.sequence)
+    gains = metrics.sequence_gains(final.errors, [fallback])
+    report("diagnosing the selected model")
+    after = diagnose_lib.diagnose(selection_windows, final.prediction, variables, **diagnose)
+    residual = selection_windows.target - final.prediction
+    local = np.column_stack([planar.rotate(residual[:, :2], -selection_windows.inputs.object_yaw), residual[:, 2]])
+    return Decision(split=split, selection=selection, fallback_gain=float(gains.sum() / final.score),
+                    fallback_p_value=float(metrics.sign_flip_pvalues(gains, seed=seed)[0]), variables=variables,
+                    diagnosis_before=before, diagnosis_after=after, noise=np.sqrt(np.mean(local ** 2, axis=0)),
+                    alpha=settings.alpha)
 
 
 def _dependences(dependences: list[diagnose_lib.Dependence]) -> list[dict]:
@@ -65,14 +165,15 @@ def close_loop(
       data_dir: root of pushes in the raw MIT layout (``<surface>/<object>/motion_surface=...h5``).
       workdir: output directory (created).
       settings: the loop's settings.
-      seed: seed of the split, the bootstraps, the cross-fitting folds and the error term.
+      seed: seed of the split, the tests, the cross-fitting folds and the error terms.
       progress: show tqdm progress bars.
 
     Returns:
       The content of ``report.json``.
 
     Raises:
-      ValueError: ``data_dir`` is not a directory or holds no usable push.
+      ValueError: ``data_dir`` is not a directory, holds no usable push, or too few push sequences to
+        select on (the message names how many were found and how many are needed).
     """
     data_dir = Path(data_dir)
     if not data_dir.is_dir():
@@ -82,8 +183,7 @@ def close_loop(
         raise ValueError(f"data_dir: no push files (motion_surface=...h5) below {str(data_dir)!r}; "
                          f"{pushes.summary()}")
     workdir = Path(workdir)
-    (workdir / report_lib.FIGURE_DIR).mkdir(parents=True, exist_ok=True)
-    stages = tqdm.tqdm(total=6, desc="close loop", unit="stage", disable=not progress)
+    stages = tqdm.tqdm(total=4, desc="close loop", unit="stage", disable=not progress)
 
     def stage(message: str) -> None:
         stages.set_postfix_str(message)
@@ -97,77 +197,81 @@ def close_loop(
     except ValueError as error:
         raise ValueError(f"data_dir: {error}") from None
     n_skipped = pushes.n_skipped + build.n_skipped
-    fit, heldout = split_by_sequence(examples, settings.heldout_fraction, seed)
     stages.update()
 
-    stage("diagnosing the plain model")
-    baseline_all = fit_lib.predict([None], examples)[0]
-    diagnose = dict(min_strength=settings.min_strength, n_bootstrap=settings.n_bootstrap, alpha=settings.alpha,
-                    seed=seed)
-    variables = [name for name, values in examples.variables.items() if len(np.unique(values)) > 1]
-    before = diagnose_lib.diagnose(examples, baseline_all, variables, **diagnose)
+    try:
+        decision = decide(examples, settings, seed, stage)
+    except ValueError as error:
+        raise ValueError(f"data_dir: {error}") from None
     stages.update()
 
-    selection = select_lib.select_effects(
-        fit, heldout, settings=settings.fit, min_gain=settings.min_gain, alpha=settings.alpha,
-        n_bootstrap=settings.n_bootstrap, seed=seed, progress=stage)
-    stages.update()
+    stage("refitting on the pool and measuring on the test split")
+    split, selection = decision.split, decision.selection
+    pool, test = split.pool, split.test
+    model = selection.model
+    term = correction_lib.fit_error_correction(pool, fit_lib.predict([model], pool)[0], settings.correction, seed)
+    plain_test, model_test = fit_lib.predict([None, model], test)
+    fallback_mean, fallback_std = term(test, model_test)
 
-    stage("diagnosing the selected model")
-    final = selection.final
-    final_all = fit_lib.predict([final.fit], examples)[0]
-    after = diagnose_lib.diagnose(examples, final_all, variables, **diagnose)
-    structured = [d for d in after if d.beyond_noise]
-    stages.update()
+    def measured(prediction):
+        errors = metrics.window_errors(prediction, test.target, test.sequence)
+        return {**report_lib.as_summary(metrics.summarize(errors)),
+                "interval": metrics.bootstrap_interval(errors, settings.n_bootstrap, seed)}
 
-    fallback = None
-    if structured:
-        stage("fitting the error-correction fallback")
-        fit_prediction = fit_lib.predict([final.fit], fit)[0]
-        heldout_prediction = fit_lib.predict([final.fit], heldout)[0]
-        correction = correction_lib.fit_error_correction(fit, fit_prediction, settings.correction, seed)
-        corrected = correction(heldout, heldout_prediction)
-        fallback = {"heldout": report_lib.as_summary(metrics.summarize(
-            metrics.window_errors(corrected, heldout.target, heldout.sequence)))}
+    yaw = np.asarray(test.inputs.object_yaw, np.float64)
+    noise = np.broadcast_to(decision.noise, model_test.shape)
     stages.update()
 
     stage("writing the report")
     report = {
-        "n_pushes": {"fit": fit.n_pushes, "heldout": heldout.n_pushes, "skipped": int(n_skipped)},
-        "baseline": report_lib.as_summary(selection.baseline.heldout),
-        "diagnosis": [{"variable": d.variable, "strength": d.strength} for d in before],
-        "ranking": [{"effect": c.effects[0], "params": c.fit.physical[c.effects[0]],
-                     "heldout": report_lib.as_summary(c.heldout)} for c in selection.ranking],
+        "n_pushes": {**split.n_pushes(), "skipped": int(n_skipped)},
+        "baseline": measured(plain_test),
+        "diagnosis": [{"variable": d.variable, "strength": d.strength} for d in decision.diagnosis_before],
+        "ranking": [{"effect": c.effects[0], "params": c.fits[0].physical[c.effects[0]],
+                     "select": report_lib.as_summary(c.summary)} for c in selection.ranking],
         "selected": selection.selected,
-        "after": report_lib.as_summary(final.heldout),
-        "explained": not structured,
-        "fallback": fallback,
+        "after": measured(model_test),
+        "explained": decision.explained,
+        "fallback": measured(fallback_mean),
+        "remaining": [{"variable": d.variable, "strength": d.strength} for d in decision.remaining],
+        "uncertainty": {
+            "selected": {**metrics.predictive_scores(model_test, noise, test.target, yaw),
+                         "noise": {"x_mm": 1e3 * float(decision.noise[0]), "y_mm": 1e3 * float(decision.noise[1]),
+                                   "rotation_deg": float(np.degrees(decision.noise[2]))}},
+            "fallback": metrics.predictive_scores(fallback_mean, fallback_std, test.target, yaw),
+        },
     }
     details = {
         "data_dir": str(data_dir),
         "horizon": settings.horizon,
         "seed": seed,
         "pusher_friction": settings.pusher_friction,
+        "alpha": settings.alpha,
         "min_gain": settings.min_gain,
-        "n_windows": {"fit": len(fit), "heldout": len(heldout)},
+        "cross_fitted": split.cross_fitted,
+        "n_sequences": {"pool": pool.n_sequences, "test": test.n_sequences},
+        "n_windows": {"fit": len(split.folds[0][0]), "select": len(split.select_index), "test": len(test)},
         "skipped": {**{reason: [p.name for p in paths] for reason, paths in pushes.skipped.items()},
                     **build.skipped},
-        "diagnosis_before": _dependences(before),
-        "diagnosis_after": _dependences(after),
-        "unexplained_variable": dataclasses.asdict(structured[0]) if structured else None,
-        "rounds": [{"gains": dict(zip(r.additions, r.gains)), "lower": r.lower, "accepted": r.accepted}
-                   for r in selection.rounds],
-        "selected_params": final.fit.physical if final.fit is not None else {},
+        "diagnosis_before": _dependences(decision.diagnosis_before),
+        "diagnosis_after": _dependences(decision.diagnosis_after),
+        "rounds": [{"gains": dict(zip(r.additions, r.gains)), "p_values": dict(zip(r.additions, r.p_values)),
+                    "level": r.level, "accepted": r.accepted} for r in selection.rounds],
+        "fallback_select": {"gain": decision.fallback_gain, "p_value": decision.fallback_p_value,
+                            "beyond_noise": decision.fallback_helps},
+        "selected_params": model.physical if model is not None else {},
     }
+    (workdir / report_lib.FIGURE_DIR).mkdir(parents=True, exist_ok=True)
     report_lib.write_json(workdir / "report.json", report)
     report_lib.write_json(workdir / "details.json", details)
     figures = workdir / report_lib.FIGURE_DIR
-    report_lib.residual_figure(figures / "residual_baseline.png", examples, baseline_all,
-                               "Residual of the plain model (median per bin)", variables)
-    report_lib.residual_figure(figures / "residual_after.png", examples, final_all,
+    selection_windows = pool.select(split.select_index)
+    report_lib.residual_figure(figures / "residual_baseline.png", selection_windows, selection.baseline.prediction,
+                               "Residual of the plain model (median per bin)", decision.variables)
+    report_lib.residual_figure(figures / "residual_after.png", selection_windows, selection.final.prediction,
                                "Residual after the fix: " + (" + ".join(selection.selected) or "nothing selected"),
-                               variables)
-    report_lib.strength_figure(figures / "diagnosis.png", before, after)
+                               decision.variables)
+    report_lib.strength_figure(figures / "diagnosis.png", decision.diagnosis_before, decision.diagnosis_after)
     (workdir / "report.md").write_text(report_lib.markdown(report, details))
     stages.update()
     stages.close()

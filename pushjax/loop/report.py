@@ -79,8 +79,9 @@ def strength_figure(path: Path, before: list, after: list) -> None:
 
 
 def _metrics_row(label: str, summary: dict) -> str:
+    low, high = (sum(bound) for bound in zip(summary["interval"]["trans_pct"], summary["interval"]["rot_pct"]))
     return (f"| {label} | {summary['trans_pct']:.1f} | {summary['rot_pct']:.1f} | {summary['trans_mm']:.3f} "
-            f"| {summary['rot_deg']:.3f} | {summary['trans_pct'] + summary['rot_pct']:.1f} |")
+            f"| {summary['rot_deg']:.3f} | {summary['trans_pct'] + summary['rot_pct']:.1f} ({low:.1f}–{high:.1f}) |")
 
 
 def _params_text(params: dict) -> str:
@@ -90,27 +91,49 @@ def _params_text(params: dict) -> str:
     return ", ".join(f"{name} = {value['value']:.4g} ± {spread(value['std'])}" for name, value in params.items()) or "-"
 
 
+def _uncertainty_row(label: str, scores: dict) -> str:
+    return f"| {label} | {scores['nlpd']:.2f} | {scores['coverage_68']:.1%} | {scores['coverage_95']:.1%} |"
+
+
 def markdown(report: dict, details: dict) -> str:
     """The readable report."""
-    header = "| model | translation % | rotation % | translation mm | rotation deg | sum % |\n|---|---|---|---|---|---|"
+    header = ("| model | translation % | rotation % | translation mm | rotation deg | sum % (95 % interval) |\n"
+              "|---|---|---|---|---|---|")
+    pushes, windows = report["n_pushes"], details["n_windows"]
+    roles = ("cross-fitted over sequence folds (every pool push fits and selects, never both for one model)"
+             if details["cross_fitted"] else "one fit split and one select split")
     lines = [
         "# Closing the loop: residual → effect → refit",
         "",
         f"Data: `{details['data_dir']}`, horizon {details['horizon']} s, seed {details['seed']}. "
-        f"Pushes: {report['n_pushes']['fit']} fit, {report['n_pushes']['heldout']} held out, "
-        f"{report['n_pushes']['skipped']} files skipped; {details['n_windows']['fit']} fit and "
-        f"{details['n_windows']['heldout']} held-out windows. Nominal model: uniform-pressure limit surface, "
-        f"pusher friction {details['pusher_friction']}. Errors are held-out means; % is relative to the "
-        "`zero` baseline (predicting no motion).",
+        f"Pushes: {pushes['fit']} fit, {pushes['select']} select, {pushes['test']} test, {pushes['skipped']} files "
+        f"skipped ({windows['fit']} fit, {windows['select']} select and {windows['test']} test windows); effects are "
+        f"chosen {roles}, refitted on every push but the test split's, and measured on the test split only. "
+        f"Nominal model: uniform-pressure limit surface, pusher friction {details['pusher_friction']}. Errors are "
+        "test-split means; % is relative to the `zero` baseline (predicting no motion); intervals are bootstrap "
+        "intervals over test push sequences.",
         "",
-        "## Before and after",
+        "## Before and after (test split)",
         "",
         header,
         _metrics_row("plain Lynch model", report["baseline"]),
         _metrics_row("selected: " + (" + ".join(report["selected"]) or "nothing"), report["after"]),
+        _metrics_row("selected + learned error term", report["fallback"]),
+        "",
+        "## How sure the model is (test split)",
+        "",
+        "Negative log predictive density per window (translation in mm, rotation in deg) and the share of the "
+        "outputs (object axes x, y and rotation) inside the central 68 % and 95 % intervals. The physical model's "
+        "noise level is fitted on its out-of-fold residual on the select split: "
+        f"{report['uncertainty']['selected']['noise']['x_mm']:.2f} mm, "
+        f"{report['uncertainty']['selected']['noise']['y_mm']:.2f} mm, "
+        f"{report['uncertainty']['selected']['noise']['rotation_deg']:.2f} deg.",
+        "",
+        "| model | NLPD | 68 % coverage | 95 % coverage |",
+        "|---|---|---|---|",
+        _uncertainty_row("selected model + fitted noise", report["uncertainty"]["selected"]),
+        _uncertainty_row("learned error term (mean and variance)", report["uncertainty"]["fallback"]),
     ]
-    if report["fallback"] is not None:
-        lines.append(_metrics_row("selected + learned error term", report["fallback"]["heldout"]))
     lines += ["", "## Diagnosis of the plain model's residual", "",
               "Strength: share of the translation + rotation error that a cross-fitted correction by the "
               "variable's bins removes (see `pushjax.loop.diagnose`); lower: one-sided bootstrap bound.", "",
@@ -118,37 +141,45 @@ def markdown(report: dict, details: dict) -> str:
     lines += [f"| {d['variable']} | {d['strength']:.3f} | {d['lower']:.3f} | {d['frame']} | {d['beyond_noise']} |"
               for d in details["diagnosis_before"]]
     lines += ["", f"![residual of the plain model]({FIGURE_DIR}/residual_baseline.png)", "",
-              "## Effects ranked by held-out error (each fitted alone)", "",
+              "## Effects ranked by select-split error (each fitted alone)", "",
               "| effect | parameters (± standard error) | sum % | translation mm | rotation deg |", "|---|---|---|---|---|"]
     lines += [f"| {entry['effect']} | {_params_text(entry['params'])} | "
-              f"{entry['heldout']['trans_pct'] + entry['heldout']['rot_pct']:.1f} | {entry['heldout']['trans_mm']:.3f} | "
-              f"{entry['heldout']['rot_deg']:.3f} |" for entry in report["ranking"]]
+              f"{entry['select']['trans_pct'] + entry['select']['rot_pct']:.1f} | {entry['select']['trans_mm']:.3f} | "
+              f"{entry['select']['rot_deg']:.3f} |" for entry in report["ranking"]]
     lines += ["", "## Forward selection", "",
-              f"An effect is added when the lower bootstrap bound of its relative held-out gain exceeds "
-              f"{details['min_gain']:.2f}.", ""]
+              f"An effect is added when its gain on the select split is beyond noise: the one-sided sign-flip test "
+              f"over select push sequences gives a p-value of at most {details['alpha']:g} over the number of "
+              f"candidates of the round (family-wise level {details['alpha']:g}), and its relative gain exceeds "
+              f"{details['min_gain']:g}.", ""]
     for k, round_ in enumerate(details["rounds"], 1):
         best = max(round_["gains"], key=round_["gains"].get)
-        lines.append(f"{k}. best addition `{best}`: gain {round_['gains'][best]:+.3f}, lower bound "
-                     f"{round_['lower']:+.3f} → {'added' if round_['accepted'] else 'stop'}")
+        lines.append(f"{k}. best addition `{best}`: gain {round_['gains'][best]:+.3f}, p = "
+                     f"{round_['p_values'][best]:.2g} (level {round_['level']:.2g}) → "
+                     f"{'added' if round_['accepted'] else 'stop'}")
     if report["selected"]:
-        lines += ["", "Fitted parameters of the selected model:", ""]
+        lines += ["", "Fitted parameters of the selected model (every pool push):", ""]
         lines += [f"- {name}: {_params_text(params)}" for name, params in details["selected_params"].items()]
-    lines += ["", "## Residual after the fix", "",
+    fallback = details["fallback_select"]
+    lines += ["", "## Residual after the fix (select split, out of fold)", "",
               "| variable | strength | lower | beyond noise |", "|---|---|---|---|"]
     lines += [f"| {d['variable']} | {d['strength']:.3f} | {d['lower']:.3f} | {d['beyond_noise']} |"
               for d in details["diagnosis_after"]]
     lines += ["", f"![residual after the fix]({FIGURE_DIR}/residual_after.png)", "",
-              f"![strengths]({FIGURE_DIR}/diagnosis.png)", ""]
+              f"![strengths]({FIGURE_DIR}/diagnosis.png)", "",
+              f"Learned error term on the select split: gain {fallback['gain']:+.3f} over the selected model, "
+              f"p = {fallback['p_value']:.2g}.", ""]
     if report["explained"]:
-        lines.append("**Explained:** no variable explains a share of the remaining error beyond noise.")
+        lines.append("**Explained:** neither a further effect, nor the learned error term, nor a correction by any "
+                     "variable lowers the error of the selected model beyond noise.")
     else:
-        variable = details["unexplained_variable"]
+        remaining = ", ".join(f"**{entry['variable']}** (a correction for it removes {entry['strength']:.1%} of the "
+                              "error)" for entry in report["remaining"]) or "no single variable"
         lines.append(
-            f"**Not explained:** no library effect removes the structured residual. It still depends on "
-            f"**{variable['variable']}** (a correction for it removes {variable['strength']:.1%} of the error, "
-            f"lower bound {variable['lower']:.1%}). A learned error-correction term (MLP on the model's inputs) "
-            f"was fitted as a fallback: held-out sum {report['fallback']['heldout']['trans_pct'] + report['fallback']['heldout']['rot_pct']:.1f} % "
-            f"instead of {report['after']['trans_pct'] + report['after']['rot_pct']:.1f} %.")
+            f"**Not explained:** no library effect removes what remains; the learned error term "
+            f"{'lowers' if fallback['beyond_noise'] else 'does not lower'} the error beyond noise, and the residual "
+            f"still depends on {remaining}. Test-split sum with the learned term "
+            f"{report['fallback']['trans_pct'] + report['fallback']['rot_pct']:.1f} % instead of "
+            f"{report['after']['trans_pct'] + report['after']['rot_pct']:.1f} %.")
     return "\n".join(lines) + "\n"
 
 

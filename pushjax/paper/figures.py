@@ -136,15 +136,16 @@ def plot(results: Mapping, workdir: str | os.PathLike) -> list[Path]:
     if name == "error_variants":
         unscaled = [row for row in rows if row["l_scale"] == 1.0 and row["model"] != "physics"]
         return [
-            line_figure(unscaled, size, "training examples", ["model"], workdir / "fig9_error_variants.png",
+            line_figure(unscaled, size, "training examples", ["model"], workdir / "table4_error_variants.png",
                         log_x=True),
             bar_figure(rows, "l_scale", ["model", "train_size"], workdir / "table5_wrong_l.png"),
         ]
-    if name == "velocities":
+    if name in ("velocities", "error_velocities"):
         trained = [row for row in rows if row["kind"] == "trained"]
         baselines = [{**row, "train_split": "baseline"} for row in rows if row["kind"] == "baseline"]
+        file = "fig6_velocities.png" if name == "velocities" else "fig9_error_variants_velocities.png"
         return [line_figure([*trained, *baselines], _velocity, "test push velocity [mm/s]",
-                            ["model", "train_split"], workdir / "fig6_velocities.png")]
+                            ["model", "train_split"], workdir / file)]
     if name == "objects":
         return [bar_figure(rows, "test_split", ["model", "train_split"], workdir / "fig7_objects.png")]
     return [bar_figure(rows, "test_split", ["model", "train_size"], workdir / f"{name}.png")]

@@ -10,16 +10,29 @@ Every binary under ``experiments/`` (the paper's experiments, ``train`` and ``vi
 
 ``steps`` is the number of optimisation steps the model has actually taken (a checkpoint can be ahead of the
 requested number). Baseline rows have ``train_split``, ``train_size``, ``seed`` and ``steps`` null. Metrics that
-are undefined (NaN) are written as null. Each sweep trains in ``<workdir>/<train_split>/l<l_scale>/<variants>``
-(checkpoints and ``metrics.csv``), so an interrupted run resumes where it stopped.
+are undefined (NaN) are written as null; ``sequences`` holds each row's per-sequence error sums (the unit of the
+standard errors, `pushjax.paper.statistics`). Besides ``rows``:
+
+* ``curves``: the learning curves, [{"model", "train_split", "train_size", "seed", "l_scale", "step", "split"
+  ("train": the model's own training examples, or "validation"), "trans_percent", "rot_percent"}, ...]
+  (`pushjax.train.curves`; a dataset without a validation split gives the training curve only);
+* ``provenance``: {"commit": the git commit of the code (with ``+changes`` when the tree differed from it),
+  "invocations": [{"commit", "started" (UTC, ISO 8601), "wall_s"}, ...] every call of `run` on this work
+  directory, a resumed one included, "wall_s": their sum}.
+
+Each sweep trains in ``<workdir>/<train_split>/l<l_scale>/<variants>`` (checkpoints, ``metrics.csv`` and
+``curves.csv``), so an interrupted run resumes where it stopped.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import datetime
 import json
 import math
 import os
+import subprocess
+import time
 import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -30,7 +43,8 @@ from pushjax import data
 from pushjax import train as train_lib
 from pushjax.paper import baselines as baselines_lib, paths
 from pushjax.paper.spec import ExperimentSpec
-from pushjax.train import evaluate
+from pushjax.models import PushModel
+from pushjax.train import curves as curves_lib, evaluate
 
 Examples = Mapping[str, np.ndarray]
 
@@ -120,24 +134,31 @@ def finite_or_none(row: Mapping) -> dict:
 
 
 def train_sweep(spec: ExperimentSpec, variants: Sequence[str], train_examples: Examples, workdir: str | os.PathLike,
-                train_split: str = "train", progress: bool = True, label: str = "") -> train_lib.SweepResult:
+                train_split: str = "train", progress: bool = True, label: str = "",
+                curve_sets: Mapping[str, Examples] | None = None) -> train_lib.SweepResult:
     """Trains `variants` side by side for every (size, seed) of `spec` (error variants share one sweep).
 
     Args:
       spec: the run.
       variants: one variant, or several error variants (`pushjax.models.ERROR_OPTIONS`).
       train_examples: {field: [N, ...]} the training split.
-      workdir: the sweep's checkpoints and ``metrics.csv``.
+      workdir: the sweep's checkpoints, ``metrics.csv`` and ``curves.csv``.
       train_split: the training split's name, for the warning when sizes are clipped.
       progress: show progress bars.
       label: what the progress bar says before the models' description (e.g. which sweep of a run).
+      curve_sets: split name -> examples the learning curves are measured on besides each model's training
+        examples (e.g. {"validation": ...}); None: none.
     """
     count = len(train_examples["motion"])
     per_model_variants = tuple(variants) if len(variants) > 1 else (None,)
     specs = train_lib.subset_specs(count, clip_sizes(spec.sizes, count, train_split), spec.seeds, per_model_variants)
     description = f"{label}{train_lib.describe_specs(variants[0], specs)} on {train_split}"
-    return train_lib.sweep(spec.train_config(variants[0]), train_examples, specs, workdir, mode=spec.mode,
-                           progress=progress, description=description)
+    config = spec.train_config(variants[0])
+    learning_curves = curves_lib.LearningCurves(
+        Path(workdir) / "curves.csv", PushModel(config.model), specs, train_examples, curve_sets or {},
+        config.curve_examples, config.eval_batch_size)
+    return train_lib.sweep(config, train_examples, specs, workdir, mode=spec.mode, progress=progress,
+                           description=description, checkpoint_callback=learning_curves)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -172,6 +193,43 @@ def _trained_rows(spec: ExperimentSpec, sweep: TrainedSweep, test_sets: Mapping[
     return rows
 
 
+def _curve_rows(sweep: TrainedSweep, workdir: Path) -> list[dict]:
+    path = workdir / "curves.csv"
+    if not path.exists():
+        return []
+    specs = sweep.result.specs
+    return [{"model": specs[row["model"]].variant or sweep.variants[0], "train_split": sweep.train_split,
+             "train_size": len(specs[row["model"]].train_indices), "seed": specs[row["model"]].seed,
+             "l_scale": sweep.l_scale, "step": row["step"], "split": row["split"],
+             "trans_percent": row["trans_percent"], "rot_percent": row["rot_percent"]}
+            for row in curves_lib.read(path)]
+
+
+def _git_commit() -> str | None:
+    """The code's git commit, ``+changes`` appended when the work tree differs from it; None outside git."""
+    root = Path(__file__).resolve().parents[2]
+    try:
+        commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True, text=True,
+                                check=True).stdout.strip()
+        changed = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root,
+                                 capture_output=True, text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return commit + ("+changes" if changed else "")
+
+
+def _provenance(workdir: Path, started: datetime.datetime, wall_s: float) -> dict:
+    """This call of `run` appended to ``<workdir>/invocations.jsonl``; the provenance of ``results.json``."""
+    log = workdir / "invocations.jsonl"
+    commit = _git_commit()
+    with log.open("a") as file:
+        file.write(json.dumps({"commit": commit, "started": started.isoformat(timespec="seconds"),
+                               "wall_s": round(wall_s, 1)}) + "\n")
+    invocations = [json.loads(line) for line in log.read_text().splitlines() if line.strip()]
+    return {"commit": commit, "invocations": invocations,
+            "wall_s": round(sum(entry["wall_s"] for entry in invocations), 1)}
+
+
 def _baseline_rows(spec: ExperimentSpec, test_sets: Mapping[str, Examples], l_scale: float) -> list[dict]:
     rows = []
     for baseline in spec.baselines:
@@ -194,15 +252,18 @@ def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True)
       progress: show progress bars.
     """
     workdir = Path(workdir)
+    started, clock = datetime.datetime.now(datetime.timezone.utc), time.monotonic()
     fields = spec.example_fields()
     splits = load_splits(spec, spec.dataset, progress)
     train_sources = _split_sources(splits, spec.train_splits, spec.dataset)
+    curve_sets = ({"validation": train_lib.examples_from_source(splits["validation"], fields)}
+                  if "validation" in splits else {})
     if spec.test_dataset != spec.dataset:
         splits = load_splits(spec, spec.test_dataset, progress)
     test_sources = _split_sources(splits, spec.test_splits, spec.test_dataset)
     test_sets = {spec.test_split_label(name): train_lib.examples_from_source(source, (*fields, *spec.test_fields))
                  for name, source in zip(spec.test_splits, test_sources)}
-    rows, sweeps = [], []
+    rows, sweeps, curve_rows = [], [], []
     train_sets = {name: train_lib.examples_from_source(source, fields)
                   for name, source in zip(spec.train_splits, train_sources)}
     planned = plan_sweeps(spec, tuple(train_sets))
@@ -211,14 +272,18 @@ def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True)
         rows += _baseline_rows(spec, scaled_tests, l_scale)
         for planned_sweep in (planned_sweep for planned_sweep in planned if planned_sweep.l_scale == l_scale):
             variants, train_split = planned_sweep.variants, planned_sweep.train_split
-            result = train_sweep(spec, variants, _scale_l(train_sets[train_split], l_scale),
-                                 workdir / train_split / f"l{l_scale:g}" / "_".join(variants), train_split,
-                                 progress, planned_sweep.label)
+            sweep_dir = workdir / train_split / f"l{l_scale:g}" / "_".join(variants)
+            result = train_sweep(spec, variants, _scale_l(train_sets[train_split], l_scale), sweep_dir, train_split,
+                                 progress, planned_sweep.label,
+                                 {name: _scale_l(examples, l_scale) for name, examples in curve_sets.items()})
             sweep = TrainedSweep(variants, train_split, l_scale, result)
             sweeps.append(sweep)
             rows += _trained_rows(spec, sweep, scaled_tests)
-    results = {"name": spec.name, "config": spec.to_json(), "rows": [finite_or_none(row) for row in rows]}
+            curve_rows += _curve_rows(sweep, sweep_dir)
+    results = {"name": spec.name, "config": spec.to_json(), "rows": [finite_or_none(row) for row in rows],
+               "curves": [finite_or_none(row) for row in curve_rows]}
     if train_lib.distributed.is_writer():
         workdir.mkdir(parents=True, exist_ok=True)
+        results["provenance"] = _provenance(workdir, started, time.monotonic() - clock)
         (workdir / "results.json").write_text(json.dumps(results, indent=2))
     return RunOutcome(spec, results, sweeps, test_sets)

@@ -58,12 +58,15 @@ class Setup:
 
 
 _PAPER_SIZES = (2_500, 190_000)
+_VELOCITY_TESTS = tuple(f"test_{v:g}" for v in data_configs.TEST_VELOCITIES)
 SETUPS = {setup.name: setup for setup in (
     Setup("data_efficiency", "data_efficiency", (*VARIANTS, *BASELINES), sizes=_PAPER_SIZES),
     Setup("new_pushes", "new_pushes", ("neural", "neural_dyn", "hybrid", "simple", "error", *BASELINES),
           sizes=_PAPER_SIZES),
-    Setup("velocities", "velocities", ("neural", "hybrid", "error", *BASELINES),
-          tuple(data_configs.VELOCITY_TRAIN_SETS), tuple(f"test_{v:g}" for v in data_configs.TEST_VELOCITIES)),
+    Setup("velocities", "velocities", ("neural", "neural_dyn", "simple", "hybrid", "error", *BASELINES),
+          tuple(data_configs.VELOCITY_TRAIN_SETS), _VELOCITY_TESTS),
+    Setup("error_velocities", "velocities", ("neural", "hybrid", *ERROR_OPTIONS, *BASELINES), ("train_20",),
+          _VELOCITY_TESTS),
     Setup("objects", "objects", ("neural", "hybrid", "error", *BASELINES),
           tuple(data_configs.OBJECT_TRAIN_SETS), tuple(data_configs.OBJECT_TEST_SETS)),
     Setup("error_variants", "data_efficiency", ("hybrid", *ERROR_OPTIONS, *BASELINES), sizes=_PAPER_SIZES,

@@ -1,7 +1,8 @@
 """Markdown tables laid out like the paper's, from the ``results`` of `pushjax.paper.runner.run`.
 
-Cells are the mean over seeds; the standard error of that mean combines the per-seed standard errors
-(``sqrt(sum se_i^2) / n``). Translation and rotation errors are percentages of the ``zero`` baseline's.
+Cells are the mean over seeds ± the standard error of `pushjax.paper.statistics` (a bootstrap over the test
+split's push sequences combined with the spread over seeds). Translation and rotation errors are percentages of
+the ``zero`` baseline's.
 """
 
 from __future__ import annotations
@@ -11,6 +12,8 @@ import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+from pushjax.paper import statistics
+
 GROUP_KEYS = ("model", "kind", "train_split", "test_split", "train_size", "l_scale")
 METRIC_LABELS = {
     "trans_percent": "trans. [%]", "rot_percent": "rot. [%]", "pos_mm": "pos. [mm]",
@@ -18,28 +21,34 @@ METRIC_LABELS = {
     "push_velocity_deg": "v_p [°]",
 }
 STATE_METRICS = ("pos_mm", "contact_mm", "normal_deg", "s", "push_velocity_deg")
+_UNCERTAIN = ("trans_percent", "rot_percent", *STATE_METRICS)
+"""Metrics given with a standard error (and its parts ``_se_sequences``, ``_se_seeds``)."""
 
 
-def aggregate(rows: Sequence[Mapping]) -> list[dict]:
-    """Rows merged over seeds: one per `GROUP_KEYS`, metrics averaged, ``*_se`` combined, ``seeds`` listed."""
+def group(rows: Sequence[Mapping]) -> dict[tuple, list[Mapping]]:
+    """Rows by cell: `GROUP_KEYS` values -> the cell's rows (one per seed)."""
     groups: dict[tuple, list[Mapping]] = {}
     for row in rows:
         groups.setdefault(tuple(row.get(key) for key in GROUP_KEYS), []).append(row)
+    return groups
+
+
+def aggregate(rows: Sequence[Mapping]) -> list[dict]:
+    """Rows merged over seeds: one per `GROUP_KEYS`, ``seeds`` listed, every numeric metric the mean over seeds
+    (None when a seed lacks it); `_UNCERTAIN` metrics also with ``_se``, ``_se_sequences`` and ``_se_seeds``."""
     merged = []
-    for key, members in groups.items():
+    for key, members in group(rows).items():
         row = dict(zip(GROUP_KEYS, key))
         row["seeds"] = [member.get("seed") for member in members]
         metrics = [name for name, value in members[0].items()
-                   if name not in GROUP_KEYS and name != "seed" and isinstance(value, (int, float, type(None)))]
+                   if name not in GROUP_KEYS and name != "seed" and "_se" not in name
+                   and (value is None or isinstance(value, (int, float)))]
         for name in metrics:
-            values = [member.get(name) for member in members]
-            finite = [float(v) for v in values if v is not None and math.isfinite(v)]
-            if len(finite) != len(values) or not finite:
-                row[name] = None
-            elif name.endswith("_se"):
-                row[name] = math.sqrt(sum(v * v for v in finite)) / len(finite)
-            else:
-                row[name] = sum(finite) / len(finite)
+            estimate = statistics.estimate(members, name)
+            row[name] = None if estimate is None else estimate.value
+            if name in _UNCERTAIN:
+                for part in ("se", "se_sequences", "se_seeds"):
+                    row[f"{name}_{part}"] = None if estimate is None else getattr(estimate, part)
         merged.append(row)
     return merged
 
@@ -117,8 +126,9 @@ def markdown(results: Mapping) -> str:
             f"## Table 2: state errors at {_largest_size(trained)} training examples\n\n"
             + metrics_table(largest, ["model"], STATE_METRICS),
         ]) + "\n"
-    if name in ("velocities", "objects"):
-        return title + f"## {'Fig. 6' if name == 'velocities' else 'Fig. 7'}: errors per test set\n\n" + pivot_table(
+    if name in ("velocities", "error_velocities", "objects"):
+        figure = {"velocities": "Fig. 6", "error_velocities": "Fig. 9", "objects": "Fig. 7"}[name]
+        return title + f"## {figure}: errors per test set\n\n" + pivot_table(
             rows, ["model", "train_split", "train_size"], "test_split") + "\n"
     if name == "error_variants":
         unscaled = [row for row in rows if row["l_scale"] == 1.0]

@@ -9,6 +9,7 @@ Modules:
   distributed: several processes (hosts) joined to train one sweep.
   checkpoint: orbax checkpoints of a (stacked) train state.
   metrics_log: the sweep's ``metrics.csv``.
+  curves: learning curves (training and validation error against steps), the sweep's ``curves.csv``.
   losses, evaluate, configs: the training losses, evaluation in the paper's units, configs.
 """
 
@@ -16,6 +17,7 @@ from pushjax.train import (
     batching,
     checkpoint,
     configs,
+    curves,
     distributed,
     evaluate,
     losses,
@@ -42,6 +44,7 @@ __all__ = [
     "batching",
     "checkpoint",
     "configs",
+    "curves",
     "distributed",
     "evaluate",
     "losses",

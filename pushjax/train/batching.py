@@ -30,7 +30,7 @@ MODEL_INPUT_FIELDS = (
     "contact_flag", "l", "mu", "camera_intrinsics", "camera_extrinsics",
 )
 """Batch fields the models and losses read, besides the image (`ModelConfig.image_field`)."""
-EVALUATION_FIELDS = ("push_velocity",)
+EVALUATION_FIELDS = ("push_velocity", "sequence_id")
 """Fields evaluation reads besides `model_fields`."""
 _BATCH_ORDER_STREAM = 1
 """Separates the batch-order random stream from other uses of a model's seed."""

@@ -1,8 +1,13 @@
 """Evaluation in the paper's units (Kloss et al., Tables 1-2).
 
 * ``trans_percent`` / ``rot_percent``: mean translation [mm] / rotation [deg] error as a percentage of
-  the ``zero`` baseline's (predicting no motion) on the same examples, with standard errors
-  (``*_se``: the error's standard error of the mean relative to the baseline's mean).
+  the ``zero`` baseline's (predicting no motion) on the same examples, with standard errors ``*_se``.
+  The windows of one push sequence are not independent (they share the object, the push and its
+  unmodelled physics), so with the examples' ``sequence_id`` the standard error is a bootstrap over push
+  sequences (`sequence_bootstrap_weights`: the ratio of summed errors to summed zero errors over
+  resampled sequences), and the per-sequence sums are returned under ``sequences`` so that results can
+  be averaged over seeds and compared pairwise on the same resamples (`pushjax.paper.statistics`).
+  Without ``sequence_id`` the examples count as independent.
 * ``pos_mm``: object-position error [mm].
 * Physical state errors of the hybrid, simple and error variants on examples with contact:
   ``contact_mm`` (contact point), ``normal_deg`` (surface normal), ``s`` (|s - contact flag|, all
@@ -13,7 +18,8 @@
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping
+import zlib
+from collections.abc import Mapping, Sequence
 
 import jax
 import numpy as np
@@ -64,6 +70,51 @@ def _angle_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
 
 
+BOOTSTRAP_SAMPLES = 2000
+"""Resamples of the push sequences behind every sequence-bootstrap standard error."""
+
+SEQUENCE_RATIOS = {
+    "trans_percent": ("trans_mm", "trans_zero_mm", 100.0),
+    "rot_percent": ("rot_deg", "rot_zero_deg", 100.0),
+    "pos_mm": ("pos_mm", "count", 1.0),
+}
+"""metric -> (numerator, denominator, factor): the metric is factor * sum(numerator) / sum(denominator) over the
+per-sequence sums of ``sequences`` (so a resample of the sequences gives a bootstrap replicate of it)."""
+
+
+def sequence_bootstrap_weights(ids: Sequence[int], samples: int = BOOTSTRAP_SAMPLES) -> np.ndarray:
+    """[samples, S] how often each of the S sequences `ids` is drawn in each bootstrap resample.
+
+    Seeded by the ids, so every model evaluated on one test split is resampled identically (differences between
+    models are paired) and different splits independently.
+    """
+    ids = np.asarray(ids, np.int64)
+    rng = np.random.default_rng([len(ids), samples, zlib.crc32(ids.tobytes())])
+    return rng.multinomial(len(ids), np.full(len(ids), 1.0 / len(ids)), size=samples).astype(np.float64)
+
+
+def bootstrap_replicates(sequences: Mapping[str, Sequence[float]], metric: str) -> np.ndarray:
+    """[BOOTSTRAP_SAMPLES] replicates of `metric` (a key of `SEQUENCE_RATIOS`) over resampled sequences.
+
+    Args:
+      sequences: the ``sequences`` of `error_metrics`: {"id": [S], "count": [S], per-sequence sums: [S]}.
+      metric: e.g. ``"trans_percent"``.
+    """
+    numerator, denominator, factor = SEQUENCE_RATIOS[metric]
+    weights = sequence_bootstrap_weights(sequences["id"])
+    return factor * (weights @ np.asarray(sequences[numerator], np.float64)) / (
+        weights @ np.asarray(sequences[denominator], np.float64))
+
+
+def _sequence_sums(sequence_id: np.ndarray, **per_example: np.ndarray) -> dict[str, list]:
+    """{"id": [S] sorted sequence ids, "count": [S] examples, name: [S] sums of each per-example array}."""
+    ids, inverse = np.unique(np.asarray(sequence_id), return_inverse=True)
+    sums = {"id": ids.tolist(), "count": np.bincount(inverse, minlength=len(ids)).tolist()}
+    for name, values in per_example.items():
+        sums[name] = np.bincount(inverse, weights=values, minlength=len(ids)).tolist()
+    return sums
+
+
 def _mean_and_se(values: np.ndarray) -> tuple[float, float]:
     if values.size == 0:
         return float("nan"), float("nan")
@@ -71,14 +122,29 @@ def _mean_and_se(values: np.ndarray) -> tuple[float, float]:
     return float(values.mean()), float(se)
 
 
-def error_metrics(predictions: Mapping[str, np.ndarray], examples: Examples) -> dict[str, float]:
-    """Errors of `predictions` (outputs of `predict`) against the ground truth in `examples`."""
+def error_metrics(predictions: Mapping[str, np.ndarray], examples: Examples) -> dict:
+    """Errors of `predictions` (outputs of `predict`) against the ground truth in `examples`.
+
+    Args:
+      predictions: {"motion": [N, 3] (m, m, rad), optionally "object_pos" [N, 2] m, "contact" [N, 2] m, "normal"
+        [N, 2], "s" [N], "push_velocity" [N, 2]}.
+      examples: the N examples (schema fields; ``sequence_id`` [N] makes the standard errors sequence bootstraps).
+
+    Returns:
+      {metric: float} as in the module docstring, and with ``sequence_id`` also ``sequences``: {"id", "count",
+      "trans_mm", "rot_deg", "trans_zero_mm", "rot_zero_deg" and with ``object_pos`` "pos_mm"}, each a list of
+      per-sequence sums over the S sequences (mm, degrees); then ``trans_percent_se``, ``rot_percent_se`` and
+      ``pos_mm_se`` are sequence-bootstrap standard errors (`bootstrap_replicates`).
+    """
     true_motion = np.asarray(examples["motion"], np.float64)
     motion = np.asarray(predictions["motion"], np.float64)
     translation_error = np.linalg.norm(motion[:, :2] - true_motion[:, :2], axis=-1) * planar.M_TO_MM
     rotation_error = np.degrees(np.abs(motion[:, 2] - true_motion[:, 2]))
     zero_translation = np.linalg.norm(true_motion[:, :2], axis=-1).mean() * planar.M_TO_MM
     zero_rotation = np.degrees(np.abs(true_motion[:, 2])).mean()
+    per_example = {"trans_mm": translation_error, "rot_deg": rotation_error,
+                   "trans_zero_mm": np.linalg.norm(true_motion[:, :2], axis=-1) * planar.M_TO_MM,
+                   "rot_zero_deg": np.degrees(np.abs(true_motion[:, 2]))}
     metrics = {"count": float(len(motion))}
     for name, error, baseline in (
         ("trans", translation_error, zero_translation), ("rot", rotation_error, zero_rotation)
@@ -89,9 +155,15 @@ def error_metrics(predictions: Mapping[str, np.ndarray], examples: Examples) -> 
         metrics[f"{name}_percent"] = 100 * mean / baseline
         metrics[f"{name}_percent_se"] = 100 * se / baseline
     if "object_pos" in predictions:
-        metrics["pos_mm"], metrics["pos_mm_se"] = _mean_and_se(
-            np.linalg.norm(predictions["object_pos"] - examples["object_pos"], axis=-1) * planar.M_TO_MM
-        )
+        per_example["pos_mm"] = np.linalg.norm(predictions["object_pos"] - examples["object_pos"], axis=-1) * planar.M_TO_MM
+        metrics["pos_mm"], metrics["pos_mm_se"] = _mean_and_se(per_example["pos_mm"])
+    if "sequence_id" in examples:
+        sequences = _sequence_sums(examples["sequence_id"], **per_example)
+        for metric in SEQUENCE_RATIOS:
+            if f"{metric}_se" in metrics:
+                replicates = bootstrap_replicates(sequences, metric)
+                metrics[f"{metric}_se"] = float(replicates.std(ddof=1)) if len(sequences["id"]) > 1 else float("nan")
+        metrics["sequences"] = sequences
     touching = np.asarray(examples["contact_flag"]) > 0.5
     if "contact" in predictions:
         metrics["contact_mm"], _ = _mean_and_se(
@@ -125,12 +197,12 @@ def error_metrics(predictions: Mapping[str, np.ndarray], examples: Examples) -> 
 def evaluate(
     model: PushModel, state: TrainState, examples: Examples, batch_size: int = 256,
     error_options: np.ndarray | None = None,
-) -> dict[str, float]:
+) -> dict:
     """`error_metrics` of one model's predictions on `examples` (arguments as in `predict`)."""
     return error_metrics(predict(model, state, examples, batch_size, error_options), examples)
 
 
-def evaluate_sweep(result: SweepResult, examples: Examples, batch_size: int = 256) -> list[dict[str, float]]:
+def evaluate_sweep(result: SweepResult, examples: Examples, batch_size: int = 256) -> list[dict]:
     """`evaluate` for every model of a sweep, in the order of `result.specs`."""
     return [
         evaluate(

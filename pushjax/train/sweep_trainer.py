@@ -84,8 +84,8 @@ def _unstack(tree: Any, count: int) -> list[Any]:
 
 @functools.lru_cache(maxsize=16)
 def _compiled_step(
-    model_config: ModelConfig, physics: Callable | None, learning_rate: float, weight_decay: float,
-    mode: str, per_model_options: bool, mesh: Mesh | None = None,
+    model_config: ModelConfig, physics: Callable | None, optimizer_settings: tuple[float, str, int],
+    weight_decay: float, mode: str, per_model_options: bool, mesh: Mesh | None = None,
 ):
     """The jitted train step of one model ("sequential") or of K stacked models ("vmap", "unroll").
 
@@ -94,7 +94,7 @@ def _compiled_step(
     Args:
       model_config: the models' architecture and variant.
       physics: replaces `PushModel.physics`, or None for the default.
-      learning_rate: Adam's step size.
+      optimizer_settings: (learning rate, schedule, number of steps) of `make_optimizer`.
       weight_decay: weight of the loss's weight penalty.
       mode: one of `SWEEP_MODES`.
       per_model_options: whether the step takes [K, 2] per-model error-term flags (else None).
@@ -102,7 +102,7 @@ def _compiled_step(
         (arguments and outputs sharded with `mesh_lib.shard`), or None for one device.
     """
     model = PushModel(model_config) if physics is None else PushModel(model_config, physics)
-    optimizer = make_optimizer(learning_rate)
+    optimizer = make_optimizer(*optimizer_settings)
     train_step = make_train_step(model, optimizer, weight_decay)
     if mode == "sequential":
         return jax.jit(train_step)
@@ -171,6 +171,7 @@ def sweep(
     progress: bool = True,
     description: str | None = None,
     step_callback: Callable[[int, Mapping[str, jax.Array]], None] | None = None,
+    checkpoint_callback: Callable[[int, TrainState], None] | None = None,
 ) -> SweepResult:
     """Trains K = len(specs) models of `train_config.model` for `train_config.num_steps` steps.
 
@@ -193,6 +194,11 @@ def sweep(
       description: the progress bar's label; by default the variants, subset sizes and seeds of `specs`.
       step_callback: called after every step with the number of completed steps and
         that step's metrics ({name: [K]} device arrays).
+      checkpoint_callback: called with a step and the K models' stacked `TrainState` at that step: before
+        training (at step 0, or at the step a resumed sweep restored, unless it is already finished) and after every
+        checkpoint (every
+        `train_config.checkpoint_every` steps and the last), also without a work directory; e.g. the
+        learning curves of `pushjax.train.curves`.
 
     Returns:
       the `SweepResult`.
@@ -206,12 +212,12 @@ def sweep(
                          "'vmap' or 'unroll'")
     model_config = train_config.model
     model = PushModel(model_config) if physics is None else PushModel(model_config, physics)
-    optimizer = make_optimizer(train_config.learning_rate)
+    optimizer_settings = (train_config.learning_rate, train_config.schedule, train_config.num_steps)
+    optimizer = make_optimizer(*optimizer_settings)
     options = _error_options(model_config, specs)
     mesh = None if mode == "sequential" else mesh_lib.sweep_mesh(len(specs))
     step_fn = _compiled_step(
-        model_config, physics, train_config.learning_rate, train_config.weight_decay, mode,
-        options is not None, mesh,
+        model_config, physics, optimizer_settings, train_config.weight_decay, mode, options is not None, mesh,
     )
     fields = model_fields(model_config)
     num_examples = len(examples[fields[0]]) if fields[0] in examples else 0
@@ -281,6 +287,8 @@ def sweep(
 
         models, stacked, local_specs = state, lambda stacked_state: stacked_state, specs
 
+    if checkpoint_callback is not None and start < train_config.num_steps:
+        checkpoint_callback(start, stacked(models))
     metrics = None
     with tqdm.tqdm(
         total=train_config.num_steps, initial=start, disable=not progress or not distributed.is_writer(),
@@ -295,10 +303,12 @@ def sweep(
                 bar.set_postfix(loss=f"{host_metrics['loss'].mean():.3f}")
                 if log is not None:
                     log.append(done, names, host_metrics)
-            if checkpointer is not None and (
-                done % train_config.checkpoint_every == 0 or done == train_config.num_steps
-            ):
-                checkpointer.save(done, stacked(models), {"identity": identity})
+            if done % train_config.checkpoint_every == 0 or done == train_config.num_steps:
+                snapshot = stacked(models)
+                if checkpointer is not None:
+                    checkpointer.save(done, snapshot, {"identity": identity})
+                if checkpoint_callback is not None:
+                    checkpoint_callback(done, snapshot)
             if step_callback is not None:
                 step_callback(done, metrics)
     if checkpointer is not None:

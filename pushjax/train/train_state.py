@@ -36,9 +36,27 @@ class TrainState:
     opt_state: Any
 
 
-def make_optimizer(learning_rate: float) -> optax.GradientTransformation:
-    """The paper's optimiser: Adam with step size `learning_rate` (> 0)."""
-    return optax.adam(learning_rate)
+SCHEDULES = ("constant", "cosine")
+"""Learning-rate schedules of `make_optimizer`."""
+
+
+def make_optimizer(learning_rate: float, schedule: str = "constant",
+                   num_steps: int | None = None) -> optax.GradientTransformation:
+    """Adam with step size `learning_rate` (> 0): constant (the paper's) or decayed.
+
+    Args:
+      learning_rate: the (initial) step size.
+      schedule: ``"constant"``, or ``"cosine"``: a cosine decay from `learning_rate` to 1 % of it over `num_steps`
+        (after which it stays there).
+      num_steps: the decay's length in steps (``"cosine"`` only).
+    """
+    if schedule == "constant":
+        return optax.adam(learning_rate)
+    if schedule == "cosine":
+        if not num_steps or num_steps < 1:
+            raise ValueError(f"num_steps: the cosine schedule needs a positive number of steps, got {num_steps}")
+        return optax.adam(optax.cosine_decay_schedule(learning_rate, num_steps, alpha=0.01))
+    raise ValueError(f"schedule: expected one of {', '.join(SCHEDULES)}, got {schedule!r}")
 
 
 def create_train_state(

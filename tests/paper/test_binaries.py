@@ -65,7 +65,7 @@ def test_objects(smoke_results):
 def test_error_variants_scales_l(smoke_results):
     tmp_path = smoke_results("error_variants")
     results = _check_results(tmp_path, "error_variants", ("error", "error_grad", "physics"),
-                             ["fig9_error_variants.png", "table5_wrong_l.png"])
+                             ["table4_error_variants.png", "table5_wrong_l.png"])
     scaled = {(row["model"], row["l_scale"]) for row in results["rows"]}
     assert scaled == {(m, 1.0) for m in ("error", "error_grad", "physics")} | {
         (m, s) for m in ("error", "physics") for s in (1.5, 3.0)}
@@ -106,7 +106,7 @@ def test_missing_workdir_is_a_usage_error():
 @pytest.mark.parametrize("binary", ["data_efficiency", "train"])
 def test_nobuild_names_the_missing_dataset_where_it_looked_and_build(tmp_path, binary):
     message = (r"^--build: dataset push_effects/data_efficiency_smoke is not built \(looked in "
-               f"{tmp_path}/push_effects/data_efficiency_smoke/2.0.0" r"\) and --nobuild forbids building it; "
+               f"{tmp_path}/push_effects/data_efficiency_smoke/3.0.0" r"\) and --nobuild forbids building it; "
                "--build builds it there$")
     with pytest.raises(app.UsageError, match=message):
         run_binary(binary, "--scale=smoke", f"--workdir={tmp_path / 'work'}", f"--data_dir={tmp_path}", "--nobuild")

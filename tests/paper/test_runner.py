@@ -14,7 +14,7 @@ def test_load_splits_says_which_dataset_it_reused(smoke_data, caplog):
         splits = runner.load_splits(spec, spec.dataset, progress=False)
     assert "train" in splits
     [message] = [record.getMessage() for record in caplog.records if record.getMessage().startswith("dataset push_effects")]
-    assert message.startswith("dataset push_effects/data_efficiency_smoke version 2.0.0: reused from ")
+    assert message.startswith("dataset push_effects/data_efficiency_smoke version 3.0.0: reused from ")
     assert str(data_dir) in message
 
 
@@ -23,7 +23,7 @@ def test_load_splits_says_where_it_built_a_dataset(tmp_path, caplog):
     with caplog.at_level(logging.INFO, logger="absl"):
         runner.load_splits(spec, spec.dataset, progress=False)
     [message] = [record.getMessage() for record in caplog.records if record.getMessage().startswith("dataset push_effects")]
-    assert message.startswith("dataset push_effects/objects_smoke version 2.0.0: built in ")
+    assert message.startswith("dataset push_effects/objects_smoke version 3.0.0: built in ")
     assert str(tmp_path) in message
 
 
