@@ -1,33 +1,51 @@
 #!/bin/bash
-# The runs behind RESULTS.md: every experiment binary at cpu scale, then the findings table.
+# The runs behind RESULTS.md: every experiment binary at cpu scale with seeds 0, 1 and 2, then the findings table.
 #
-#   bash scripts/results.sh [RUNS_DIR]      (default: work/results; about 2 h on 2 CPU cores)
+#   bash scripts/results.sh [RUNS_DIR]      (default: work/results; SEEDS=0,1,2 and SCALE=cpu by default)
 #
-# error_variants at l = 1 trains exactly data_efficiency's hybrid and error-variant sweeps (same
-# specs, seeds and subsets), so their finished checkpoints are copied over and only the l = 1.5 and
-# l = 3 models are trained. velocities and objects run 2 500 steps instead of the cpu
-# config's 5 000 to fit the session that produced RESULTS.md.
+# Resumable: stop it at any time and run it again. Training resumes from each sweep's last checkpoint, and an
+# experiment whose `<RUNS_DIR>/<name>/results.json` exists is not run again (delete that file to redo its tables;
+# its finished sweeps are reused). Each run's log is `<RUNS_DIR>/<name>.log`; every results.json records the git
+# commit and the wall time of every sitting (`provenance`).
+#
+# Sweeps that two experiments share are trained once: error_variants at l = 1 is data_efficiency's hybrid and
+# error-variant sweeps, visualize evaluates data_efficiency's models, error_velocities (Fig. 9) reuses the
+# velocities sweeps of neural and hybrid trained at 20 mm/s; their finished checkpoints are copied over.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-work/results}
+seeds=${SEEDS:-0,1,2}
+scale=${SCALE:-cpu}
 export MUJOCO_GL=${MUJOCO_GL:-egl}
 python=${PYTHON:-.venv/bin/python}
-run() { local name=$1; shift; mkdir -p "$runs/$name"; { time "$python" -m experiments.$name --workdir="$runs/$name" "$@"; } > "$runs/$name.log" 2>&1; }
-run data_efficiency
-mkdir -p "$runs/error_variants/train"
-cp -rn "$runs/data_efficiency/train/l1" "$runs/error_variants/train/"
-run error_variants
-run new_pushes
-run velocities --num_steps=2500
-run objects --num_steps=2500
-"$python" -m experiments.findings --workdirs="$runs/data_efficiency,$runs/new_pushes,$runs/velocities,$runs/error_variants" \
-  --output="$runs/findings.md"
 
-# Train vs test error of neural, neural_dyn and hybrid from data_efficiency (RESULTS.md, "most data"):
-# the finished sweeps are copied and evaluated on their own training split (no training happens).
-for variant in neural neural_dyn hybrid; do
-  rm -rf "$runs/analysis/$variant"; mkdir -p "$runs/analysis/$variant/train/l1"
-  cp -r "$runs/data_efficiency/train/l1/$variant" "$runs/analysis/$variant/train/l1/"
-  "$python" -m experiments.train --variant=$variant --experiment=data_efficiency --scale=cpu \
-    --workdir="$runs/analysis/$variant" --sizes=2500,190000 --test_split=train
-done
+run() {
+  local name=$1; shift
+  if [[ -f "$runs/$name/results.json" ]]; then echo "$name: done ($runs/$name/results.json)"; return; fi
+  echo "$name: running (log $runs/$name.log)"
+  mkdir -p "$runs/$name"
+  "$python" -m experiments."$name" --workdir="$runs/$name" --scale="$scale" --seeds="$seeds" "$@" \
+    >> "$runs/$name.log" 2>&1
+}
+share() {  # share FROM TO SWEEP...: copy finished sweeps of experiment FROM into experiment TO
+  local from=$1 to=$2; shift 2
+  for sweep in "$@"; do
+    if [[ -d "$runs/$from/$sweep" && ! -e "$runs/$to/$sweep" ]]; then
+      mkdir -p "$(dirname "$runs/$to/$sweep")"; cp -r "$runs/$from/$sweep" "$runs/$to/$sweep"
+    fi
+  done
+}
+
+run data_efficiency
+share data_efficiency error_variants train/l1/hybrid train/l1/error_error_grad_error_norm
+run error_variants
+share data_efficiency visualize train/l1/neural train/l1/hybrid train/l1/simple train/l1/error
+run visualize --sizes=2500,190000
+run new_pushes
+run velocities
+share velocities error_velocities train_20/l1/neural train_20/l1/hybrid
+run error_velocities
+run objects
+run viewpoint
+"$python" -m experiments.findings --workdirs="$(ls -d "$runs"/{data_efficiency,new_pushes,velocities,error_velocities,error_variants,objects} 2>/dev/null | paste -sd,)" \
+  --output="$runs/findings.md"
