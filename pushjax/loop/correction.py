@@ -98,7 +98,7 @@ def _features(examples: Examples, prediction: np.ndarray) -> np.ndarray:
     return np.column_stack([
         planar.rotate(np.asarray(inputs.contact), -yaw), planar.rotate(np.asarray(inputs.normal), -yaw),
         planar.rotate(np.asarray(inputs.action), -yaw), planar.rotate(np.asarray(inputs.pusher_motion), -yaw),
-        inputs.gap, inputs.l, inputs.mu, inputs.s, inputs.push_speed, inputs.time_after_stop,
+        inputs.gap, inputs.l, inputs.mu, inputs.s, inputs.push_speed, inputs.time_after_stop, inputs.object_position,
         planar.rotate(prediction[:, :2], -yaw), prediction[:, 2],
     ])
 

@@ -183,96 +183,96 @@ def close_loop(
         raise ValueError(f"data_dir: no push files (motion_surface=...h5) below {str(data_dir)!r}; "
                          f"{pushes.summary()}")
     workdir = Path(workdir)
-    stages = tqdm.tqdm(total=4, desc="close loop", unit="stage", disable=not progress)
+    # Closed before an error propagates, so that the error is the last line the user sees.
+    with tqdm.tqdm(total=4, desc="close loop", unit="stage", disable=not progress) as stages:
 
-    def stage(message: str) -> None:
-        stages.set_postfix_str(message)
+        def stage(message: str) -> None:
+            stages.set_postfix_str(message)
 
-    stage("loading pushes")
-    loading = tqdm.tqdm(pushes, total=len(pushes.paths), desc="pushes", unit="push", disable=not progress,
-                        leave=False)
-    try:
-        examples, build = build_examples(loading, horizon=settings.horizon, stride=settings.stride,
-                                         pusher_friction=settings.pusher_friction)
-    except ValueError as error:
-        raise ValueError(f"data_dir: {error}") from None
-    n_skipped = pushes.n_skipped + build.n_skipped
-    stages.update()
+        stage("loading pushes")
+        loading = tqdm.tqdm(pushes, total=len(pushes.paths), desc="pushes", unit="push", disable=not progress,
+                            leave=False)
+        try:
+            examples, build = build_examples(loading, horizon=settings.horizon, stride=settings.stride,
+                                             pusher_friction=settings.pusher_friction)
+        except ValueError as error:
+            raise ValueError(f"data_dir: {error}") from None
+        n_skipped = pushes.n_skipped + build.n_skipped
+        stages.update()
 
-    try:
-        decision = decide(examples, settings, seed, stage)
-    except ValueError as error:
-        raise ValueError(f"data_dir: {error}") from None
-    stages.update()
+        try:
+            decision = decide(examples, settings, seed, stage)
+        except ValueError as error:
+            raise ValueError(f"data_dir: {error}") from None
+        stages.update()
 
-    stage("refitting on the pool and measuring on the test split")
-    split, selection = decision.split, decision.selection
-    pool, test = split.pool, split.test
-    model = selection.model
-    term = correction_lib.fit_error_correction(pool, fit_lib.predict([model], pool)[0], settings.correction, seed)
-    plain_test, model_test = fit_lib.predict([None, model], test)
-    fallback_mean, fallback_std = term(test, model_test)
+        stage("refitting on the pool and measuring on the test split")
+        split, selection = decision.split, decision.selection
+        pool, test = split.pool, split.test
+        model = selection.model
+        term = correction_lib.fit_error_correction(pool, fit_lib.predict([model], pool)[0], settings.correction, seed)
+        plain_test, model_test = fit_lib.predict([None, model], test)
+        fallback_mean, fallback_std = term(test, model_test)
 
-    def measured(prediction):
-        errors = metrics.window_errors(prediction, test.target, test.sequence)
-        return {**report_lib.as_summary(metrics.summarize(errors)),
-                "interval": metrics.bootstrap_interval(errors, settings.n_bootstrap, seed)}
+        def measured(prediction):
+            errors = metrics.window_errors(prediction, test.target, test.sequence)
+            return {**report_lib.as_summary(metrics.summarize(errors)),
+                    "interval": metrics.bootstrap_interval(errors, settings.n_bootstrap, seed)}
 
-    yaw = np.asarray(test.inputs.object_yaw, np.float64)
-    noise = np.broadcast_to(decision.noise, model_test.shape)
-    stages.update()
+        yaw = np.asarray(test.inputs.object_yaw, np.float64)
+        noise = np.broadcast_to(decision.noise, model_test.shape)
+        stages.update()
 
-    stage("writing the report")
-    report = {
-        "n_pushes": {**split.n_pushes(), "skipped": int(n_skipped)},
-        "baseline": measured(plain_test),
-        "diagnosis": [{"variable": d.variable, "strength": d.strength} for d in decision.diagnosis_before],
-        "ranking": [{"effect": c.effects[0], "params": c.fits[0].physical[c.effects[0]],
-                     "select": report_lib.as_summary(c.summary)} for c in selection.ranking],
-        "selected": selection.selected,
-        "after": measured(model_test),
-        "explained": decision.explained,
-        "fallback": measured(fallback_mean),
-        "remaining": [{"variable": d.variable, "strength": d.strength} for d in decision.remaining],
-        "uncertainty": {
-            "selected": {**metrics.predictive_scores(model_test, noise, test.target, yaw),
-                         "noise": {"x_mm": 1e3 * float(decision.noise[0]), "y_mm": 1e3 * float(decision.noise[1]),
-                                   "rotation_deg": float(np.degrees(decision.noise[2]))}},
-            "fallback": metrics.predictive_scores(fallback_mean, fallback_std, test.target, yaw),
-        },
-    }
-    details = {
-        "data_dir": str(data_dir),
-        "horizon": settings.horizon,
-        "seed": seed,
-        "pusher_friction": settings.pusher_friction,
-        "alpha": settings.alpha,
-        "min_gain": settings.min_gain,
-        "cross_fitted": split.cross_fitted,
-        "n_sequences": {"pool": pool.n_sequences, "test": test.n_sequences},
-        "n_windows": {"fit": len(split.folds[0][0]), "select": len(split.select_index), "test": len(test)},
-        "skipped": {**{reason: [p.name for p in paths] for reason, paths in pushes.skipped.items()},
-                    **build.skipped},
-        "diagnosis_before": _dependences(decision.diagnosis_before),
-        "diagnosis_after": _dependences(decision.diagnosis_after),
-        "rounds": [{"gains": dict(zip(r.additions, r.gains)), "p_values": dict(zip(r.additions, r.p_values)),
-                    "level": r.level, "accepted": r.accepted} for r in selection.rounds],
-        "fallback_select": {"gain": decision.fallback_gain, "p_value": decision.fallback_p_value,
-                            "beyond_noise": decision.fallback_helps},
-        "selected_params": model.physical if model is not None else {},
-    }
-    (workdir / report_lib.FIGURE_DIR).mkdir(parents=True, exist_ok=True)
-    report_lib.write_json(workdir / "report.json", report)
-    report_lib.write_json(workdir / "details.json", details)
-    figures = workdir / report_lib.FIGURE_DIR
-    selection_windows = pool.select(split.select_index)
-    report_lib.residual_figure(figures / "residual_baseline.png", selection_windows, selection.baseline.prediction,
-                               "Residual of the plain model (median per bin)", decision.variables)
-    report_lib.residual_figure(figures / "residual_after.png", selection_windows, selection.final.prediction,
-                               "Residual after the fix: " + (" + ".join(selection.selected) or "nothing selected"),
-                               decision.variables)
-    report_lib.strength_figure(figures / "diagnosis.png", decision.diagnosis_before, decision.diagnosis_after)
-    (workdir / "report.md").write_text(report_lib.markdown(report, details))
-    stages.update()
-    stages.close()
+        stage("writing the report")
+        report = {
+            "n_pushes": {**split.n_pushes(), "skipped": int(n_skipped)},
+            "baseline": measured(plain_test),
+            "diagnosis": [{"variable": d.variable, "strength": d.strength} for d in decision.diagnosis_before],
+            "ranking": [{"effect": c.effects[0], "params": c.fits[0].physical[c.effects[0]],
+                         "select": report_lib.as_summary(c.summary)} for c in selection.ranking],
+            "selected": selection.selected,
+            "after": measured(model_test),
+            "explained": decision.explained,
+            "fallback": measured(fallback_mean),
+            "remaining": [{"variable": d.variable, "strength": d.strength} for d in decision.remaining],
+            "uncertainty": {
+                "selected": {**metrics.predictive_scores(model_test, noise, test.target, yaw),
+                             "noise": {"x_mm": 1e3 * float(decision.noise[0]), "y_mm": 1e3 * float(decision.noise[1]),
+                                       "rotation_deg": float(np.degrees(decision.noise[2]))}},
+                "fallback": metrics.predictive_scores(fallback_mean, fallback_std, test.target, yaw),
+            },
+        }
+        details = {
+            "data_dir": str(data_dir),
+            "horizon": settings.horizon,
+            "seed": seed,
+            "pusher_friction": settings.pusher_friction,
+            "alpha": settings.alpha,
+            "min_gain": settings.min_gain,
+            "cross_fitted": split.cross_fitted,
+            "n_sequences": {"pool": pool.n_sequences, "test": test.n_sequences},
+            "n_windows": {"fit": len(split.folds[0][0]), "select": len(split.select_index), "test": len(test)},
+            "skipped": {**{reason: [p.name for p in paths] for reason, paths in pushes.skipped.items()},
+                        **build.skipped},
+            "diagnosis_before": _dependences(decision.diagnosis_before),
+            "diagnosis_after": _dependences(decision.diagnosis_after),
+            "rounds": [{"gains": dict(zip(r.additions, r.gains)), "p_values": dict(zip(r.additions, r.p_values)),
+                        "level": r.level, "accepted": r.accepted} for r in selection.rounds],
+            "fallback_select": {"gain": decision.fallback_gain, "p_value": decision.fallback_p_value,
+                                "beyond_noise": decision.fallback_helps},
+            "selected_params": model.physical if model is not None else {},
+        }
+        (workdir / report_lib.FIGURE_DIR).mkdir(parents=True, exist_ok=True)
+        report_lib.write_json(workdir / "report.json", report)
+        report_lib.write_json(workdir / "details.json", details)
+        figures = workdir / report_lib.FIGURE_DIR
+        selection_windows = pool.select(split.select_index)
+        report_lib.residual_figure(figures / "residual_baseline.png", selection_windows, selection.baseline.prediction,
+                                   "Residual of the plain model (median per bin)", decision.variables)
+        report_lib.residual_figure(figures / "residual_after.png", selection_windows, selection.final.prediction,
+                                   "Residual after the fix: " + (" + ".join(selection.selected) or "nothing selected"),
+                                   decision.variables)
+        report_lib.strength_figure(figures / "diagnosis.png", decision.diagnosis_before, decision.diagnosis_after)
+        (workdir / "report.md").write_text(report_lib.markdown(report, details))
+        stages.update()
     return report

@@ -260,7 +260,7 @@ def _annotate_object(name: str, rows: list[dict], pusher_friction: float) -> dic
         action=np.asarray(contact.action_from_contact), pusher_motion=motion, gap=gap,
         l=np.full(count, limit_surface_ratio(obj)), mu=np.full(count, float(pusher_friction)),
         s=touches.astype(np.float64), object_yaw=yaw, push_speed=data["push_speed"],
-        time_after_stop=data["time_after_stop"],
+        time_after_stop=data["time_after_stop"], object_position=com0,
         target=np.column_stack([com1 - com0, pose1[:, 2] - pose0[:, 2]]),
         sequence=data["sequence"], push=data["push"], variables=variables,
     )

@@ -62,7 +62,26 @@ composed. The effects (the keys of :data:`EFFECTS`, applied in this order whatev
     gave it, ``v = push_speed |V| / |u|`` (``|V|`` the motion of a point at distance ``l``),
     decelerated by Coulomb friction at ``a = 1 / inverse_deceleration`` (``= mu_s g``). Within the
     time ``t`` left after the stop it slides ``v t - a t^2 / 2`` until it stops after the decay length
-    ``v^2 / (2 a)``, along its last motion.
+    ``v^2 / (2 a)``, along its last motion: the dynamics after contact is lost.
+
+``friction_field``  {"gradient": [2] 1/m, "curvature": [3] 1/m^2 (xx, xy, yy), world axes}
+    The support friction varies smoothly over the table: ``log mu(p) = g . p + p^T H p / 2`` (a low-order
+    field over the table position ``p`` of the centre of mass; a uniform change cancels in quasi-static
+    pushing). Across the plate the coefficient changes by ``exp(grad log mu . r)``, which moves the centre of
+    friction by the support's second moment times the gradient, ``(9/16) l^2 grad log mu(p)`` (a disc's
+    moment, isotropic approximation), world axes: the same push at another place of the table turns the
+    object differently.
+``friction_speed``  {"inverse_deceleration": [] s^2/m, >= 0, "gain": [] per decade}
+    The support coefficient depends on the sliding speed, ``mu(v) = mu_ref (1 + gain log10(v / 20 mm/s))``
+    (clipped at ``0.1 mu_ref``, constant below 1 mm/s). In quasi-static pushing a uniform coefficient cancels;
+    it shows in the slide after the pusher stops (as ``inertia``, which is ``gain = 0``), decelerated at
+    ``a(v) = a_ref mu(v) / mu_ref`` for the speed ``v`` the push gave the object.
+``pressure_gradient``  {"offset": [2] m, object axes}
+    A support pressure that rises linearly across the plate (a warped plate, a hidden weight): it moves the
+    centre of friction by ``offset`` and, about the new centre, leaves the mean squared radius
+    ``E|r|^2 - |offset|^2``, so ``l`` shrinks to ``l sqrt(1 - |offset|^2 / ((9/8) l^2))`` (a disc's
+    ``E|r|^2 = (9/8) l^2``). One mechanism, so the shift and ``l`` move together (unlike ``cof_offset`` plus
+    ``friction_ratio``).
 
 All branches are double-``where`` selections, so gradients are finite everywhere, including the
 no-effect parameters, ``normal = 0``, ``action = 0`` and ``s = 0``.
@@ -115,6 +134,8 @@ class PushInputs:
       object_yaw: [...] orientation of the object (tracked frame) in the world, rad.
       push_speed: [...] pusher speed when it stops in the window, or at the window's end, m/s.
       time_after_stop: [...] time from the pusher's stop to the window's end, s (0: still moving).
+      object_position: [..., 2] position of the nominal centre of mass on the table at the window's start,
+        world axes, m.
     """
 
     contact: jax.Array
@@ -128,19 +149,21 @@ class PushInputs:
     object_yaw: jax.Array
     push_speed: jax.Array
     time_after_stop: jax.Array
+    object_position: jax.Array
 
     @classmethod
     def create(cls, contact, normal, action, l, mu, s=1.0, *, pusher_motion=None, gap=0.0,
-               object_yaw=0.0, push_speed=0.0, time_after_stop=0.0) -> PushInputs:
+               object_yaw=0.0, push_speed=0.0, time_after_stop=0.0, object_position=(0.0, 0.0)) -> PushInputs:
         """Inputs from ``lynch.predict``'s arguments; the others default to a pusher in contact
-        (``pusher_motion = action``, ``gap = 0``), object yaw 0 and a pusher that does not stop."""
+        (``pusher_motion = action``, ``gap = 0``), object yaw 0 at the table's origin and a pusher that does
+        not stop."""
         action = jnp.asarray(action)
         return cls(
             contact=jnp.asarray(contact), normal=jnp.asarray(normal), action=action,
             pusher_motion=action if pusher_motion is None else jnp.asarray(pusher_motion),
             gap=jnp.asarray(gap), l=jnp.asarray(l), mu=jnp.asarray(mu), s=jnp.asarray(s),
             object_yaw=jnp.asarray(object_yaw), push_speed=jnp.asarray(push_speed),
-            time_after_stop=jnp.asarray(time_after_stop),
+            time_after_stop=jnp.asarray(time_after_stop), object_position=jnp.asarray(object_position),
         )
 
 
@@ -304,11 +327,12 @@ def _table_tilt_physical(params):
             "downhill_azimuth_deg": jnp.degrees(jnp.arctan2(force[..., 1], force[..., 0]))}
 
 
-def _inertia_correct(params, twist, state, inputs):
-    inverse_deceleration = params["inverse_deceleration"]
+def _slide_after_contact(twist, state, inputs, inverse_deceleration_at):
+    """The twist plus the slide after the pusher stops, decelerated at ``1 / inverse_deceleration_at(speed)``."""
     motion, moving = _safe_norm(jnp.stack([_safe_norm(twist[..., :2])[0], state.l * twist[..., 2]], -1))
     push, pushed = _safe_norm(state.action)
     speed = inputs.push_speed * motion / jnp.where(pushed, push, 1.0)
+    inverse_deceleration = inverse_deceleration_at(speed)
     time = inputs.time_after_stop
     # v^2 / (2 a) when the object stops within the window (v / a < t), else v t - a t^2 / 2; written with
     # 1 / a, which is 0 without effect.
@@ -317,6 +341,61 @@ def _inertia_correct(params, twist, state, inputs):
     slide = jnp.where(stops, 0.5 * speed * speed * inverse_deceleration, speed * time - time * time / (2 * safe_inverse))
     factor = jnp.where(moving & pushed, slide / jnp.where(moving, motion, 1.0), 0.0)
     return twist * (1.0 + factor[..., None])
+
+
+def _inertia_correct(params, twist, state, inputs):
+    return _slide_after_contact(twist, state, inputs, lambda speed: params["inverse_deceleration"])
+
+
+def _speed_factor(gain, speed):
+    """Support friction at ``speed`` [...] (m/s) over that at :data:`SPEED_REFERENCE`."""
+    return jnp.maximum(1.0 + gain * jnp.log10(jnp.maximum(speed, SPEED_FLOOR) / SPEED_REFERENCE), 0.1)
+
+
+def _friction_speed_correct(params, twist, state, inputs):
+    return _slide_after_contact(twist, state, inputs,
+                                lambda speed: params["inverse_deceleration"] / _speed_factor(params["gain"], speed))
+
+
+def _friction_speed_project(params):
+    return {"inverse_deceleration": jnp.maximum(params["inverse_deceleration"], 0.0), "gain": params["gain"]}
+
+
+def _friction_speed_physical(params):
+    return {**_inertia_physical(params), "gain_per_decade": params["gain"]}
+
+
+def _friction_field_modify(params, state, inputs):
+    gradient, curvature = params["gradient"], params["curvature"]
+    x, y = inputs.object_position[..., 0], inputs.object_position[..., 1]
+    # Gradient of log mu(p) = g . p + p^T H p / 2 where the object is.
+    local = jnp.stack([gradient[..., 0] + curvature[..., 0] * x + curvature[..., 1] * y,
+                       gradient[..., 1] + curvature[..., 1] * x + curvature[..., 2] * y], axis=-1)
+    # Friction weighting exp(grad . r) moves the centre of friction by the support's second moment times the
+    # gradient; the second moment per axis is SECOND_MOMENT l^2 (isotropic approximation).
+    shift = SECOND_MOMENT * (state.l ** 2)[..., None] * local
+    return state.replace(contact=state.contact - shift, centre=state.centre + shift)
+
+
+def _friction_field_physical(params):
+    gradient, curvature = params["gradient"], params["curvature"]
+    return {"gradient_x_per_m": gradient[..., 0], "gradient_y_per_m": gradient[..., 1],
+            "curvature_xx_per_m2": curvature[..., 0], "curvature_xy_per_m2": curvature[..., 1],
+            "curvature_yy_per_m2": curvature[..., 2]}
+
+
+def _pressure_gradient_modify(params, state, inputs):
+    offset = _rotate(params["offset"], inputs.object_yaw)
+    # A linear pressure gradient that moves the centre of pressure by c leaves E|r - c|^2 = E|r|^2 - |c|^2 about
+    # it; with E|r|^2 = MEAN_SQUARE_RADIUS l^2, l shrinks by the same factor's square root.
+    share = jnp.sum(params["offset"] ** 2, axis=-1) / (MEAN_SQUARE_RADIUS * state.l ** 2)
+    return state.replace(contact=state.contact - offset, centre=state.centre + offset,
+                         l=state.l * jnp.sqrt(jnp.maximum(1.0 - share, 0.05)))
+
+
+def _pressure_gradient_physical(params):
+    return {**_offset_physical(params),
+            "offset_over_l": jnp.hypot(params["offset"][..., 0], params["offset"][..., 1])}
 
 
 def _inertia_project(params):
@@ -329,6 +408,14 @@ def _inertia_physical(params):
             "decay_length_mm_at_100_mm_s": 1e3 * 0.5 * 0.1 ** 2 * inverse}
 
 
+SPEED_REFERENCE = 0.02
+"""Sliding speed (m/s) at which ``friction_speed``'s coefficient is the reference one (the MIT grid's 20 mm/s)."""
+SPEED_FLOOR = 1e-3
+"""Sliding speed (m/s) below which ``friction_speed``'s coefficient stops changing."""
+SECOND_MOMENT = 9 / 16
+"""Second moment of a plate's support per axis over l^2 (a uniform disc's: R^2 / 4 with l = 2 R / 3)."""
+MEAN_SQUARE_RADIUS = 9 / 8
+"""Mean squared distance of a plate's support from its centre over l^2 (a uniform disc's; 1.14 for a square)."""
 _MAX_DRIFT_FORCE = 0.95
 """Largest in-plane force over the maximal friction force: beyond 1 the object slides away unpushed."""
 
@@ -354,6 +441,12 @@ EFFECTS: dict[str, Effect] = {
                _table_tilt_project, _table_tilt_physical, True),
         Effect("inertia", _zeros(inverse_deceleration=()), {"inverse_deceleration": 0.3}, None,
                _inertia_correct, _inertia_project, _inertia_physical, False),
+        Effect("friction_field", _zeros(gradient=(2,), curvature=(3,)), {"gradient": 3.0, "curvature": 30.0},
+               _friction_field_modify, None, _identity, _friction_field_physical, False),
+        Effect("friction_speed", _zeros(inverse_deceleration=(), gain=()), {"inverse_deceleration": 0.3, "gain": 0.3},
+               None, _friction_speed_correct, _friction_speed_project, _friction_speed_physical, False),
+        Effect("pressure_gradient", _zeros(offset=(2,)), {"offset": 0.01}, _pressure_gradient_modify, None,
+               _identity, _pressure_gradient_physical, False),
     )
 }
 """The library, in the order in which effects are applied."""

@@ -29,3 +29,16 @@ def test_missing_or_empty_data_dir_names_the_flag(tmp_path):
     empty = run(f"--data_dir={tmp_path / 'empty'}", f"--workdir={tmp_path / 'out'}")
     assert empty.returncode != 0 and "--data_dir" in empty.stderr and "no push files" in empty.stderr
     assert not (tmp_path / "out" / "report.json").exists()
+
+
+def test_too_few_push_sequences_stop_with_one_line(record, tmp_path):
+    few = tmp_path / "few"
+    for path in sorted(record("clean").rglob("*.h5"))[:3]:
+        target = few / path.relative_to(record("clean"))
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.symlink_to(path)
+    result = run(f"--data_dir={few}", f"--workdir={tmp_path / 'out'}")
+    assert result.returncode != 0 and "Traceback" not in result.stderr
+    line = result.stderr.strip().splitlines()[-1]
+    assert "--data_dir" in line and "push sequences: found 3, need at least" in line
+    assert not (tmp_path / "out" / "report.json").exists()

@@ -6,9 +6,10 @@ import dataclasses
 import numpy as np
 import pytest
 
-from pushjax.loop import correction, fit, metrics, select
+from pushjax.loop import correction, fit, metrics, select, splits
 from pushjax.loop.windows import build_examples, split_by_sequence
 from pushjax.mit.files import iter_pushes
+from pushjax.physics.effects import EFFECT_NAMES
 
 TRUE = {"cof_offset": {"offset": np.array([0.008, -0.004])},
         "friction_ratio": {"log_scale": np.array(np.log(1.4))}}
@@ -43,12 +44,15 @@ def test_fits_several_candidates_at_once_and_recovers_the_parameters(synthetic):
 
 
 def test_forward_selection_adds_both_effects_and_stops(synthetic):
-    train, heldout = split_by_sequence(synthetic, 0.3, seed=1)
-    selection = select.select_effects(train, heldout, n_bootstrap=300)
+    split = splits.split(synthetic, len(EFFECT_NAMES), seed=1)
+    selection = select.select_effects(split)
     assert sorted(selection.selected) == ["cof_offset", "friction_ratio"]
     assert selection.rounds[-1].accepted is None and len(selection.rounds) == 3
     assert selection.ranking[0].effects[0] in TRUE
     assert selection.final.score < 0.5 * selection.baseline.score
+    # The reported model is refitted on the pool: fit and select sequences, never the test split's.
+    assert set(selection.model.effects) == set(TRUE)
+    assert not set(split.pool.sequence) & set(split.test.sequence)
 
 
 def test_error_correction_learns_what_the_model_misses(synthetic):
@@ -56,10 +60,13 @@ def test_error_correction_learns_what_the_model_misses(synthetic):
     plain_train, plain_heldout = fit.predict([None], train)[0], fit.predict([None], heldout)[0]
     term = correction.fit_error_correction(train, plain_train, correction.CorrectionSettings(steps=600), seed=0)
     before = metrics.combined(metrics.summarize(metrics.window_errors(plain_heldout, heldout.target, heldout.sequence)))
-    corrected = term(heldout, plain_heldout)
+    corrected, std = term(heldout, plain_heldout)
     after = metrics.combined(metrics.summarize(metrics.window_errors(corrected, heldout.target, heldout.sequence)))
     assert after < 0.8 * before
-    np.testing.assert_array_equal(term(heldout, plain_heldout), corrected)
+    np.testing.assert_array_equal(term(heldout, plain_heldout)[0], corrected)
+    # The predicted spread follows the error: its 95 % intervals hold most of the held-out outputs.
+    scores = metrics.predictive_scores(corrected, std, heldout.target, heldout.inputs.object_yaw)
+    assert 0.8 < scores["coverage_95"] <= 1 and scores["coverage_68"] < scores["coverage_95"]
 
 
 def test_unknown_effects_are_rejected(synthetic):

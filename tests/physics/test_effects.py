@@ -27,7 +27,7 @@ def _random_inputs(seed, count=5000, dtype=np.float32):
                   s=(rng.uniform(size=count) > 0.1).astype(float), pusher_motion=motion,
                   gap=rng.uniform(-0.002, 0.005, count), object_yaw=rng.uniform(-np.pi, np.pi, count),
                   push_speed=rng.uniform(0.01, 0.5, count), time_after_stop=rng.uniform(0, 0.5, count)
-                  * (rng.uniform(size=count) > 0.5))
+                  * (rng.uniform(size=count) > 0.5), object_position=rng.uniform(-0.2, 0.2, (count, 2)))
     return effects.PushInputs(**{name: jnp.asarray(value, dtype) for name, value in values.items()})
 
 
@@ -49,6 +49,11 @@ def _random_params(seed):
         "pusher_friction": {"log_scale": jnp.asarray(rng.normal(0, 0.3), jnp.float32)},
         "table_tilt": {"drift_force": jnp.asarray(rng.normal(0, 0.2, 2), jnp.float32)},
         "inertia": {"inverse_deceleration": jnp.asarray(rng.uniform(0, 1), jnp.float32)},
+        "friction_field": {"gradient": jnp.asarray(rng.normal(0, 1, 2), jnp.float32),
+                           "curvature": jnp.asarray(rng.normal(0, 5, 3), jnp.float32)},
+        "friction_speed": {"inverse_deceleration": jnp.asarray(rng.uniform(0, 1), jnp.float32),
+                           "gain": jnp.asarray(rng.normal(0, 0.3), jnp.float32)},
+        "pressure_gradient": {"offset": jnp.asarray(rng.normal(0, 0.005, 2), jnp.float32)},
     }
 
 
@@ -278,3 +283,49 @@ def test_projection_keeps_parameters_physical():
                                         "table_tilt": {"drift_force": jnp.asarray([3.0, 4.0])}})
     assert float(projected["inertia"]["inverse_deceleration"]) == 0.0
     np.testing.assert_allclose(projected["table_tilt"]["drift_force"], [0.57, 0.76], rtol=1e-6)
+
+
+def test_friction_field_moves_the_centre_of_friction_towards_higher_friction():
+    inputs = _random_inputs(7, count=256)
+    gradient, curvature = np.array([4.0, -2.0]), np.array([10.0, -5.0, 20.0])
+    field = effects.compose(["friction_field"])(
+        {"friction_field": {"gradient": jnp.asarray(gradient), "curvature": jnp.asarray(curvature)}}, inputs)
+    # The same as a centre-of-friction offset of (9/16) l^2 grad log mu(p), turned into the object's axes.
+    position = np.asarray(inputs.object_position)
+    local = gradient + np.stack([curvature[0] * position[:, 0] + curvature[1] * position[:, 1],
+                                 curvature[1] * position[:, 0] + curvature[2] * position[:, 1]], axis=1)
+    shift = 9 / 16 * np.asarray(inputs.l)[:, None] ** 2 * local
+    yaw = np.asarray(inputs.object_yaw)
+    in_object = np.stack([np.cos(yaw) * shift[:, 0] + np.sin(yaw) * shift[:, 1],
+                          -np.sin(yaw) * shift[:, 0] + np.cos(yaw) * shift[:, 1]], axis=1)
+    offset = effects.compose(["cof_offset"])({"cof_offset": {"offset": jnp.asarray(in_object, jnp.float32)}}, inputs)
+    np.testing.assert_allclose(field, offset, atol=1e-6)
+
+
+def test_pressure_gradient_moves_the_centre_and_shrinks_l_together():
+    inputs = _random_inputs(8, count=256)
+    offset = jnp.asarray([0.006, -0.004])
+    gradient = effects.compose(["pressure_gradient"])({"pressure_gradient": {"offset": offset}}, inputs)
+    share = float(jnp.sum(offset ** 2)) / (9 / 8 * np.asarray(inputs.l) ** 2)
+    both = effects.compose(["cof_offset", "friction_ratio"])(
+        {"cof_offset": {"offset": offset},
+         "friction_ratio": {"log_scale": jnp.asarray(0.5 * np.log(1 - share), jnp.float32)}}, inputs)
+    np.testing.assert_allclose(gradient, both, atol=1e-6)
+
+
+def test_friction_speed_is_inertia_at_zero_gain_and_shortens_fast_slides_when_rate_strengthening():
+    normal = np.array([1.0, 0.0])
+    inputs = effects.PushInputs.create([-0.03, 0.0], normal, [0.01, 0.0], 0.03, 10.0, push_speed=0.2,
+                                       time_after_stop=0.3)
+    inertia = effects.compose(["inertia"])({"inertia": {"inverse_deceleration": jnp.asarray(0.4)}}, inputs)
+
+    def speed_model(gain):
+        return effects.compose(["friction_speed"])(
+            {"friction_speed": {"inverse_deceleration": jnp.asarray(0.4), "gain": jnp.asarray(gain)}}, inputs)
+
+    np.testing.assert_allclose(speed_model(0.0), inertia, rtol=1e-6)
+    # 200 mm/s is a decade above the reference: +30 % friction, a slide shorter by 1 / 1.3.
+    plain = float(_lynch(inputs)[0])
+    np.testing.assert_allclose(float(speed_model(0.3)[0]) - plain, (float(inertia[0]) - plain) / 1.3, rtol=1e-5)
+    gradient = jax.grad(lambda gain: speed_model(gain)[0])(0.0)
+    assert np.isfinite(gradient) and gradient < 0
