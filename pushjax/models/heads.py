@@ -10,7 +10,8 @@ name in `config.VARIANTS`.
 * ``neural_dyn``: the ``neural`` FC stack fed the ground-truth physical state (contact, normal,
   contact flag, action, l, mu) instead of perception.
 * ``hybrid``: FC stack from [glimpse encoding, action] -> contact point, normal and contact
-  indicator s (sigmoid); v_o = ``physics(contact, normal, action, l, mu, s)`` (Lynch's model).
+  indicator s (sigmoid); v_o = ``physics(contact, normal, action, l, mu, s)`` (Lynch's model), whose
+  derivative gets `lynch.with_push_gate_gradient`'s straight-through push gate (values unchanged).
 * ``simple``: FC stack from [glimpse encoding, action] -> effective push velocity v_p and contact
   point; v_o = ``lynch.object_velocity(contact, v_p, l)`` (stage 2 only).
 * ``error``: ``hybrid`` plus an additive error term from [glimpse encoding, action, object position,
@@ -230,11 +231,22 @@ class HybridHead(Head):
         s = nn.sigmoid(s_logit)
         outputs = {"contact": contact, "normal": normal, "s": s, "s_logit": s_logit}
         if scene.view.separates_contact_indicator:
-            motion_given_contact = self.physics(contact, normal, action, l, mu, jnp.ones_like(s))
+            motion_given_contact = self._physics_motion(contact, normal, action, l, mu, jnp.ones_like(s))
             outputs.update(motion=_column(s) * motion_given_contact, motion_given_contact=motion_given_contact)
         else:
-            outputs["motion"] = self.physics(contact, normal, action, l, mu, s)
+            outputs["motion"] = self._physics_motion(contact, normal, action, l, mu, s)
         return outputs
+
+    def _physics_motion(self, contact, normal, action, l, mu, s) -> jax.Array:
+        """[B, 3] `physics` twist (dx, dy [m], dyaw [rad]) with `lynch.with_push_gate_gradient`'s derivative.
+
+        The values are `physics`'s, bit for bit; the straight-through push gate lets a normal predicted facing
+        away from the push still learn from the motion loss. Arguments as `physics` takes them: contact [B, 2]
+        relative to the centre of mass [m], normal [B, 2] (any length), action [B, 2] [m], l [B] [m], mu [B],
+        s [B] in [0, 1].
+        """
+        motion = self.physics(contact, normal, action, l, mu, s)
+        return lynch.with_push_gate_gradient(motion, contact, normal, action, l, mu, s)
 
 
 class ErrorHead(HybridHead):

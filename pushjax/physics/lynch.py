@@ -9,7 +9,8 @@ maximal friction torque and force; the pusher-object friction by a Coulomb cone 
    ``v_p`` of the pusher motion ``u`` that is transmitted to the object.
 2. :func:`object_velocity` maps ``v_p`` to the object twist ``(dx, dy, dtheta)``.
 
-:func:`predict` chains both and scales ``v_p`` by a contact indicator ``s``.
+:func:`predict` chains both and scales ``v_p`` by a contact indicator ``s``. Its derivative is the exact one;
+:func:`with_push_gate_gradient` adds a training signal where a push does not push (see there).
 
 Conventions shared by all functions:
 
@@ -50,27 +51,28 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-__all__ = ["check_inputs", "effective_push_velocity", "object_velocity", "predict"]
+__all__ = ["check_inputs", "effective_push_velocity", "object_velocity", "predict", "with_push_gate_gradient"]
 
 
-_POINTS = ("contact", "normal", "action", "v_p")
-"""The arguments that are 2-vectors in the last axis; all others are one number per push."""
+_VECTOR_SIZES = {"contact": 2, "normal": 2, "action": 2, "v_p": 2, "motion": 3}
+"""The arguments that are vectors in the last axis, and their sizes; all others are one number per push."""
 
 
 def _check_shapes_and_dtypes(arrays: dict) -> None:
     """Raises ``ValueError`` naming the first of `arrays` (name -> array) that is not real numbers of the right shape.
 
     Reads only ``.shape`` and ``.dtype``, so it works on tracers (``jax.jit``, ``jax.vmap``, ``jax.grad``) when
-    a function is traced and costs nothing at run time. Points (`_POINTS`) are [..., 2], the other arguments
-    [...], and the batch shapes [...] must broadcast against each other.
+    a function is traced and costs nothing at run time. Vectors (`_VECTOR_SIZES`) are [..., size], the other
+    arguments [...], and the batch shapes [...] must broadcast against each other.
     """
     batch_shapes = {}
     for name, value in arrays.items():
         if not (jnp.issubdtype(value.dtype, jnp.floating) or jnp.issubdtype(value.dtype, jnp.integer)):
             raise ValueError(f"{name}: expected a real numeric array, got dtype {value.dtype}")
-        if name in _POINTS:
-            if value.ndim == 0 or value.shape[-1] != 2:
-                raise ValueError(f"{name}: expected shape [..., 2], got {value.shape}")
+        if name in _VECTOR_SIZES:
+            size = _VECTOR_SIZES[name]
+            if value.ndim == 0 or value.shape[-1] != size:
+                raise ValueError(f"{name}: expected shape [..., {size}], got {value.shape}")
             batch_shapes[name] = value.shape[:-1]
         else:
             batch_shapes[name] = value.shape
@@ -303,6 +305,105 @@ def predict(
         jnp.asarray(l, dtype), jnp.asarray(mu, dtype), jnp.asarray(s, dtype),
     )
     return jnp.stack(twist, axis=-1)
+
+
+@jax.custom_jvp
+def _straight_through_push_gate(motion, cx, cy, nx, ny, ux, uy, l, mu, s):
+    """`motion` itself; the tangent adds the surrogate of :func:`with_push_gate_gradient`."""
+    return motion
+
+
+@_straight_through_push_gate.defjvp
+def _straight_through_push_gate_jvp(primals, tangents):
+    motion, cx, cy, nx, ny, ux, uy, l, mu, s = primals
+    d_motion, _, _, d_nx, d_ny, d_ux, d_uy, *_ = tangents
+    normal_push = ux * nx + uy * ny  # |n| (u . n / |n|): the pusher's speed into the surface, times |n|
+    normal_squared = nx * nx + ny * ny
+    action_squared = ux * ux + uy * uy
+    # The gate normal: perpendicular to u (length |u|), on the side of n; n turned towards u reaches it first.
+    side = jnp.where(ux * ny - uy * nx >= 0, 1, -1)
+    gate_x, gate_y = -side * uy, side * ux
+    boundary_x, boundary_y, torque, boundary_velocity_dot_n = _slip_boundary(
+        cx, cy, gate_x, gate_y, ux, uy, l, mu
+    )
+    gated = (normal_push <= 0) & (normal_squared > 0) & (action_squared > 0) & (boundary_velocity_dot_n > 0)
+    safe_normal_squared = jnp.where(gated, normal_squared, 1)
+    # |n| times the tangent of u . n / |n| at fixed |n|: d(u . n) with the part of dn along n removed, so the
+    # surrogate, like the model, does not depend on the normal's length and only turns the normal.
+    d_normal_push = (
+        nx * d_ux + ny * d_uy + ux * d_nx + uy * d_ny
+        - normal_push * (nx * d_nx + ny * d_ny) / safe_normal_squared
+    )
+    # d(u . n) / (v_pb . n) (l^2 f_b, c x f_b) at the gate normal scaled to |n| (the factor is homogeneous of
+    # degree -1 in the normal, hence |u| / |n|): the slipping twist's derivative just past the gate.
+    length_ratio = jnp.sqrt(jnp.where(gated, action_squared / safe_normal_squared, 1))
+    ratio = jnp.where(
+        gated, s * d_normal_push * length_ratio / jnp.where(gated, boundary_velocity_dot_n, 1), 0
+    )
+    surrogate = jnp.stack([ratio * l * l * boundary_x, ratio * l * l * boundary_y, ratio * torque], axis=-1)
+    return motion, d_motion + surrogate.astype(motion.dtype)
+
+
+@jax.jit
+def with_push_gate_gradient(
+    motion: jax.Array,
+    contact: jax.Array,
+    normal: jax.Array,
+    action: jax.Array,
+    l: jax.Array,
+    mu: jax.Array,
+    s: jax.Array = 1.0,
+) -> jax.Array:
+    """`motion`, bit for bit, with a straight-through derivative through the push gate of Lynch's stage 1.
+
+    A point pusher cannot pull, so the model gives no motion, and no derivative, where ``u . n <= 0``
+    (``u = action``, ``n = normal``): a learned normal that faces away from the push, or along it, gets no
+    signal from a loss on the motion and is never turned back. Past the gate the push slips, and the twist
+    ``s relu(u . n) / (v_pb . n) (l^2 f_b, c x f_b)`` grows linearly in ``u . n`` from zero. Where
+    ``u . n <= 0``, this function adds to the derivative of `motion` that slipping derivative with relu's
+    derivative taken as 1 (straight-through), evaluated where the normal would cross the gate:
+    ``s d(u . n) / (v_pb . n) (l^2 f_b, c x f_b)`` at the normal turned towards ``u`` until perpendicular to
+    it (length kept), with the friction-cone boundary ``f_b`` on the side where ``u`` leaves the motion cone
+    there. The normal's part of ``d(u . n)`` is turned perpendicular to ``n``, so that, like the model, the
+    surrogate does not depend on the normal's length and only turns it: towards ``u`` when the loss asks for
+    the motion that crossing the gate would start, away otherwise. At the gate it equals the exact derivative
+    from the slipping side, so the derivative is continuous there. Elsewhere (pushing, ``normal = 0``,
+    ``action = 0``, or ``v_pb . n <= 0`` at the gate) the derivative is the one of `motion`; it is finite
+    everywhere.
+
+    It is meant for training (the hybrid heads wrap their physics in it): the surrogate derivative is not the
+    model's, so code that needs the exact derivative (fitting effects, Jacobian tests) calls :func:`predict`
+    alone. Forward values never change, so evaluation is unaffected whichever is used.
+
+    Args:
+      motion: [..., 3] the twist ``(dx, dy, dtheta)`` predicted for this push, usually ``predict(contact,
+        normal, action, l, mu, s)`` [length (per step), length (per step), rad (per step)].
+      contact: [..., 2] contact point relative to the object's centre of mass [length].
+      normal: [..., 2] surface normal at the contact, pointing into the object; any length,
+        zero means no contact.
+      action: [..., 2] pusher motion u [length (per step)].
+      l: [...] limit-surface ratio max torque / max force [length], > 0.
+      mu: [...] pusher-object friction coefficient [-], >= 0.
+      s: [...] contact indicator in [0, 1] scaling the effective push velocity.
+
+    Returns:
+      [..., 3] `motion`, with the derivative described above.
+    """
+    motion, contact, normal, action, l, mu, s = map(jnp.asarray, (motion, contact, normal, action, l, mu, s))
+    _check_shapes_and_dtypes(
+        {"motion": motion, "contact": contact, "normal": normal, "action": action, "l": l, "mu": mu, "s": s}
+    )
+    batch_shape = jnp.broadcast_shapes(
+        motion.shape[:-1], contact.shape[:-1], normal.shape[:-1], action.shape[:-1], l.shape, mu.shape, s.shape
+    )
+    dtype = jnp.result_type(contact, normal, action, l, mu, s, float)
+    cx, cy = _split_xy(contact, dtype)
+    nx, ny = _split_xy(normal, dtype)
+    ux, uy = _split_xy(action, dtype)
+    return _straight_through_push_gate(
+        jnp.broadcast_to(motion, (*batch_shape, 3)), cx, cy, nx, ny, ux, uy,
+        jnp.asarray(l, dtype), jnp.asarray(mu, dtype), jnp.asarray(s, dtype),
+    )
 
 
 def check_inputs(contact, normal, action, l, mu, s=1.0) -> None:

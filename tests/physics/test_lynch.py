@@ -429,3 +429,102 @@ def test_stages_check_shapes_and_dtypes(function, arguments, message):
     with pytest.raises(ValueError, match=message):
         function(**arguments)
 
+
+
+def _gated_predict(contact, normal, action, l, mu, s=1.0):
+    """`lynch.predict` with the straight-through push gate, as the hybrid heads train it."""
+    motion = lynch.predict(contact, normal, action, l, mu, s)
+    return lynch.with_push_gate_gradient(motion, contact, normal, action, l, mu, s)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_push_gate_gradient_keeps_the_motion_bit_for_bit(dtype):
+    pushes = [x.astype(dtype) for x in _random_pushes(np.random.default_rng(7), 1000)]
+    with jax.enable_x64(dtype == np.float64):
+        motion = np.asarray(lynch.predict(*pushes))
+        gated = np.asarray(_gated_predict(*pushes))
+    assert gated.dtype == dtype
+    np.testing.assert_array_equal(gated.view(np.uint8), motion.view(np.uint8))
+
+
+def _facing_away_push(normal_angle):
+    """A push along +y at a contact below the centre of mass, its predicted normal at `normal_angle` [rad] and
+    the motion the true normal (+y) gives, which the loss asks for."""
+    contact, action, l, mu = np.array([0.01, -0.03]), np.array([0.0, 0.01]), 0.04, 0.3
+    target = np.asarray(lynch.predict(contact, [0.0, 1.0], action, l, mu))
+    return contact, _unit(normal_angle), action, l, mu, target
+
+
+def _motion_loss(physics, contact, action, l, mu, target):
+    """Squared motion error [cm^2 + rad^2] as a function of the normal."""
+    weights = jnp.asarray([1e4, 1e4, 1.0])
+    return lambda normal: jnp.sum(weights * (physics(contact, normal, action, l, mu) - target) ** 2)
+
+
+def _angle_deg(a, b):
+    return np.degrees(np.arccos(np.dot(a, b) / np.linalg.norm(a) / np.linalg.norm(b)))
+
+
+@pytest.mark.parametrize("degrees_from_push", [95, 120, 150, 175, -95, -120, -150, -175])
+def test_normal_facing_away_from_the_push_is_turned_towards_it(degrees_from_push):
+    contact, normal, action, l, mu, target = _facing_away_push(np.radians(90 + degrees_from_push))
+    assert np.dot(normal, action) < 0
+    exact = jax.jit(jax.grad(_motion_loss(lynch.predict, contact, action, l, mu, target)))
+    gated_loss = jax.jit(_motion_loss(_gated_predict, contact, action, l, mu, target))
+    gated = jax.jit(jax.grad(gated_loss))
+    np.testing.assert_array_equal(exact(normal), 0.0)  # what training got before
+    gradient = np.asarray(gated(normal))
+    assert np.linalg.norm(gradient) > 0
+    assert abs(np.dot(gradient, normal)) < 1e-5 * np.linalg.norm(gradient)  # turns the normal, keeps its length
+    initial_loss = gated_loss(normal)
+    angles = [_angle_deg(normal, action)]
+    for _ in range(300):
+        normal = normal - 50 * np.asarray(gated(normal))
+        angles.append(_angle_deg(normal, action))
+    # Each step turns it towards the push until it pushes; then the exact gradient fits the motion.
+    pushing = int(np.argmax(np.asarray(angles) < 90))
+    assert pushing > 0 and np.all(np.diff(angles[: pushing + 1]) < 0)
+    assert gated_loss(normal) < 1e-6 * initial_loss
+
+
+def test_push_gate_gradient_is_the_exact_derivative_where_the_pusher_pushes():
+    pushes = _random_pushes(np.random.default_rng(8), 200)
+    pushing = np.sum(pushes[1] * pushes[2], -1) > 0
+    assert 10 < (~pushing).sum() < 100
+    with jax.enable_x64(True):
+        exact = jax.vmap(jax.jacrev(lynch.predict, argnums=range(6)))(*pushes)
+        gated = jax.vmap(jax.jacrev(_gated_predict, argnums=range(6)))(*pushes)
+    for argument, (jacobian, gated_jacobian) in enumerate(zip(exact, gated)):
+        np.testing.assert_array_equal(gated_jacobian[pushing], jacobian[pushing], err_msg=f"argument {argument}")
+        if argument not in (1, 2):  # only the normal and the action open the gate
+            np.testing.assert_array_equal(gated_jacobian[~pushing], jacobian[~pushing], err_msg=f"argument {argument}")
+
+
+def test_push_gate_gradient_is_continuous_at_the_gate():
+    contact, action, l, mu = np.array([0.01, -0.03]), np.array([0.004, 0.01]), 0.04, 0.5
+    gate = np.arctan2(action[1], action[0]) - np.pi / 2  # the normal perpendicular to the push
+    with jax.enable_x64(True):
+        pushing, facing_away = (
+            np.asarray(jax.jacfwd(_gated_predict, argnums=(1, 2))(contact, _unit(gate + side * 1e-7), action, l, mu))
+            for side in (1, -1)
+        )
+    assert np.abs(pushing).max() > 0
+    np.testing.assert_allclose(facing_away, pushing, rtol=1e-5, atol=1e-6 * np.abs(pushing).max())
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+@pytest.mark.parametrize("name", sorted(_DEGENERATE_PUSHES))
+def test_push_gate_gradients_are_finite_on_degenerate_pushes(name, dtype):
+    push = _DEGENERATE_PUSHES[name]
+    args = [push[key] for key in ("contact", "normal", "action", "l", "mu", "s")]
+    for gradient in _all_gradients(_gated_predict, dtype, *args):
+        assert gradient.dtype == dtype
+        assert np.all(np.isfinite(gradient)), name
+    for normal in ([0.0, -1.0], [0.0, -1e-6]):  # facing away, of any length
+        for gradient in _all_gradients(_gated_predict, dtype, *args[:1], normal, *args[2:]):
+            assert np.all(np.isfinite(gradient)), name
+
+
+def test_push_gate_gradient_checks_the_motion_shape():
+    with pytest.raises(ValueError, match=r"motion: expected shape \[\.\.\., 3\]"):
+        lynch.with_push_gate_gradient(np.zeros(2), [0.01, -0.03], [0.0, 1.0], [0.0, 0.01], 0.04, 0.5)
