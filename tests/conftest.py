@@ -4,6 +4,7 @@ import functools
 import os
 import pathlib
 
+import filelock
 import pytest
 
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -19,16 +20,45 @@ def shared_dir() -> pathlib.Path:
     return SHARED
 
 
+def _shared_folder(tmp_path_factory) -> pathlib.Path:
+    """A folder all pytest-xdist workers of this run share (the parent of each worker's own base folder)."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
+def once_across_workers(path: pathlib.Path, make) -> pathlib.Path:
+    """Calls ``make()`` the first time any worker asks for `path` (under a file lock; a marker says it is done),
+    so every worker reuses what one of them made."""
+    with filelock.FileLock(f"{path}.lock"):
+        done = path.with_name(f"{path.name}.done")
+        if not done.exists():
+            make()
+            done.touch()
+    return path
+
+
 @pytest.fixture(scope="session")
 def smoke_data(tmp_path_factory):
-    """experiment -> the TFDS data directory holding its smoke dataset (built on first request, once per session)."""
+    """experiment -> the TFDS data directory holding its smoke dataset (built once per test run, by whichever
+    worker asks first; the others wait for it and reuse it)."""
     from pushjax.data import testing
 
-    data_dir = tmp_path_factory.mktemp("smoke_data")
+    data_dir = _shared_folder(tmp_path_factory) / "smoke_data"
 
     @functools.cache
     def build(experiment):
-        testing.smoke_dataset(data_dir, experiment)
+        # One lock for all experiments: their datasets share the raw push cache in `data_dir`.
+        with filelock.FileLock(f"{data_dir}.lock"):
+            done = data_dir / f".{experiment}.done"
+            if not done.exists():
+                testing.smoke_dataset(data_dir, experiment)
+                done.touch()
         return data_dir
 
     return build
+
+
+@pytest.fixture(scope="session")
+def shared_folder(tmp_path_factory) -> pathlib.Path:
+    """A folder all pytest-xdist workers of this run share (for results made once, see `once_across_workers`)."""
+    return _shared_folder(tmp_path_factory)

@@ -25,7 +25,8 @@ for binary, commands in json.loads(sys.argv[1]).items():
         except flags.Error as error:
             sys.exit(f"{binary} {arguments}: {error}")
 """
-SHARED_FLAGS = ("data_efficiency", "new_pushes", "velocities", "objects", "error_variants", "viewpoint", "visualize",
+SHARED_FLAGS = ("data_efficiency", "new_pushes", "velocities", "error_velocities", "objects", "error_variants",
+                "viewpoint", "visualize",
                 "train", "findings", "demo")
 """Binaries whose flags can live in one process (absl refuses two modules defining the same flag name)."""
 

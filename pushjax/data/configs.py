@@ -13,7 +13,8 @@ Experiments (split names in brackets):
 ``data_efficiency`` [train, validation, test]
     All 11 objects at 20 mm/s on abs, a random 5/6 : 1/6 split of each object's sequences into train and test,
     and ``test_pushes_per_object`` further sequences per object for validation (learning curves and the choice of
-    the training schedule; never reported as a result).
+    the training schedule; never reported as a result), fewer where the object's MIT grid has no more distinct
+    pushes (the triangles at ``paper`` scale: 7).
 ``new_pushes`` [train, validation, test]
     The same sequences; test holds every push at the angles 0° and ±20° and every push at a held-out tenth of
     each object's contact points (side, point); the rest is split 5/6 : 1/6 into train and validation.
@@ -67,7 +68,7 @@ import numpy as np
 
 from pushjax.geometry.objects import OBJECT_NAMES, get_object
 from pushjax.mit.files import PushParams, push_file_path
-from pushjax.mit.protocol import side_points
+from pushjax.mit.protocol import MIT_ANGLES, side_points
 from pushjax.sim.dataset import PushJob, plan_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.testbed import DEFAULT_PROFILE, PROFILES, Testbed
@@ -260,6 +261,11 @@ def _split_off(items: list, fraction: float, rng: np.random.Generator) -> tuple[
     return [items[i] for i in rest], [items[i] for i in held]
 
 
+def _distinct_pushes(obj: str) -> int:
+    """The pushes of ``obj`` on the MIT grid at one velocity: sides x contact points x angles."""
+    return len(get_object(obj).sides) * len(side_points(obj)) * len(MIT_ANGLES)
+
+
 def held_out_contact_points(obj: str, config: DatasetConfig) -> frozenset[int]:
     """Contact point ids (see :func:`contact_point_id`) of ``obj`` held out for the ``new_pushes`` test."""
     count = len(get_object(obj).sides) * len(side_points(obj))
@@ -286,9 +292,11 @@ def plan_splits(config: DatasetConfig, raw_dir: str | Path) -> SplitPlan:
     if experiment in ("data_efficiency", "viewpoint"):
         per_split = {"train": [], "validation": [], "test": []}
         for obj in OBJECT_NAMES:
-            pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object + config.test_pushes_per_object, config, raw_dir)
+            # The MIT grid of a triangle has 297 distinct pushes per velocity: at paper scale that leaves 7 for validation.
+            validations = min(config.test_pushes_per_object, _distinct_pushes(obj) - config.pushes_per_object)
+            pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object + validations, config, raw_dir)
             rng = np.random.default_rng(_key(config.seed, obj, experiment, "split"))
-            pool, validation = _split_off(pool, config.test_pushes_per_object / len(pool), rng)
+            pool, validation = _split_off(pool, validations / len(pool), rng)
             train, test = _split_off(pool, config.test_fraction, rng)
             for name, jobs in (("train", train), ("validation", validation), ("test", test)):
                 per_split[name] += jobs

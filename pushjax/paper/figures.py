@@ -121,6 +121,49 @@ def bar_figure(rows: Sequence[Mapping], group_key: str, series_keys: Sequence[st
     return _finish(figure, axes, path)
 
 
+def _curve_means(curves: Sequence[Mapping]) -> dict[tuple, tuple[np.ndarray, np.ndarray]]:
+    """(model, train_split, train_size, l_scale, split) -> (steps [T], score [T] averaged over seeds)."""
+    by_step: dict[tuple, dict[int, list[float]]] = {}
+    for row in curves:
+        key = (row["model"], row["train_split"], row["train_size"], row["l_scale"], row["split"])
+        by_step.setdefault(key, {}).setdefault(row["step"], []).append(
+            (row["trans_percent"] + row["rot_percent"]) / 2.0)
+    return {key: (np.asarray(sorted(steps)), np.asarray([np.mean(steps[step]) for step in sorted(steps)]))
+            for key, steps in by_step.items()}
+
+
+def curves_figure(curves: Sequence[Mapping], path: str | os.PathLike) -> Path:
+    """Learning curves: a panel per model, the score (mean of trans. and rot. % of zero, mean over seeds) on the
+    model's own training examples (dashed) and on the validation split (solid) against steps, a line per training
+    size (darker: larger)."""
+    means = _curve_means(curves)
+    models = sorted({key[0] for key in means}, key=lambda m: MODEL_ORDER.index(m) if m in MODEL_ORDER else 99)
+    sizes = sorted({key[2] for key in means})
+    columns = min(4, len(models))
+    rows = -(-len(models) // columns)
+    figure, axes = plt.subplots(rows, columns, figsize=(3.2 * columns, 2.8 * rows), squeeze=False, sharex=True)
+    for axis, model in zip(axes.flat, models):
+        for (name, _, size, _, split), (steps, scores) in sorted(means.items(), key=lambda item: str(item[0])):
+            if name != model:
+                continue
+            shade = 0.45 + 0.55 * (sizes.index(size) + 1) / len(sizes)
+            colour = tuple(shade * c + (1 - shade) for c in matplotlib.colors.to_rgb(_colour(model)))
+            axis.plot(steps, scores, linestyle="--" if split == "train" else "-", color=colour,
+                      label=f"{size:,} examples, {split}")
+        axis.set_title(model, fontsize="medium")
+        axis.set_xlabel("training step")
+        axis.set_ylabel("score [% of zero]")
+        axis.set_ylim(bottom=0, top=min(150, axis.get_ylim()[1]))
+        axis.grid(alpha=0.3)
+        axis.legend(fontsize="x-small", frameon=False)
+    for axis in list(axes.flat)[len(models):]:
+        axis.set_visible(False)
+    figure.tight_layout()
+    figure.savefig(path, dpi=100, bbox_inches="tight")
+    plt.close(figure)
+    return Path(path)
+
+
 def _velocity(row):
     digits = "".join(ch for ch in row["test_split"] if ch.isdigit())
     return float(digits) if digits else None
@@ -130,9 +173,10 @@ def plot(results: Mapping, workdir: str | os.PathLike) -> list[Path]:
     """The figures of one experiment (chosen by ``results["name"]``), written to `workdir` as PNG."""
     name, rows, workdir = results["name"], tables.aggregate(results["rows"]), Path(workdir)
     size = lambda row: row["train_size"]  # noqa: E731
+    curves = [curves_figure(results["curves"], workdir / "learning_curves.png")] if results.get("curves") else []
     if name == "data_efficiency":
         return [line_figure(rows, size, "training examples", ["model"], workdir / "fig5_data_efficiency.png",
-                            log_x=True)]
+                            log_x=True), *curves]
     if name == "error_variants":
         unscaled = [row for row in rows if row["l_scale"] == 1.0 and row["model"] != "physics"]
         return [

@@ -107,7 +107,7 @@ def estimate(rows: Sequence[Mapping], metric: str) -> Estimate | None:
     se_seeds = _seed_se(values) if trained else None
     replicates = [_row_replicates(row, metric) for row in rows]
     ids = {tuple(row["sequences"]["id"]) for row in rows if row.get("sequences")}
-    if all(replicate is not None for replicate in replicates) and len(ids) == 1:
+    if all(replicate is not None for replicate in replicates) and len(ids) == 1 and len(next(iter(ids))) > 1:
         mean_replicates = np.mean(replicates, axis=0)
         return Estimate(float(np.mean(values)), float(mean_replicates.std(ddof=1)), se_seeds, tuple(values),
                         mean_replicates, ids.pop())

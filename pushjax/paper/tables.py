@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-from pushjax.paper import statistics
+from pushjax.paper import reference, statistics
 
 GROUP_KEYS = ("model", "kind", "train_split", "test_split", "train_size", "l_scale")
 METRIC_LABELS = {
@@ -71,12 +71,17 @@ def _markdown(header: Sequence[str], body: Sequence[Sequence[str]]) -> str:
     return "\n".join(lines)
 
 
+PaperCell = Callable[[Mapping, object], "str | None"]
+"""(aggregated row, column value or None) -> the paper's value of that cell (`pushjax.paper.reference`), or None."""
+
+
 def pivot_table(rows: Sequence[Mapping], row_keys: Sequence[str], column_key: str,
-                metrics: Sequence[str] = ("trans_percent", "rot_percent")) -> str:
+                metrics: Sequence[str] = ("trans_percent", "rot_percent"), paper: PaperCell | None = None) -> str:
     """A table with a row per distinct `row_keys` and a column per value of `column_key`.
 
     Each cell shows `metrics` separated by `` / ``. Rows whose `column_key` is null (the baselines' training
-    size) fill every column.
+    size) fill every column. With `paper`, each column is followed by the paper's values of its cells (when the
+    paper has any).
     """
     columns = sorted({row[column_key] for row in rows if row.get(column_key) is not None}, key=_sort_key)
     if not columns:
@@ -86,16 +91,27 @@ def pivot_table(rows: Sequence[Mapping], row_keys: Sequence[str], column_key: st
         label = tuple(_row_label(row, row_keys))
         for column in columns if row.get(column_key) is None else [row[column_key]]:
             cells.setdefault(label, {})[column] = " / ".join(format_value(row, metric) for metric in metrics)
-    header = [*row_keys, *(f"{column_key}={column}" for column in columns)]
-    body = [[*label, *(values.get(column, "") for column in columns)] for label, values in cells.items()]
+            if paper is not None and (value := paper(row, column)) is not None:
+                cells[label][("paper", column)] = value
+    with_paper = {column for values in cells.values() for key in values if isinstance(key, tuple)
+                  for column in [key[1]]}
+    keys = [key for column in columns for key in ([column, ("paper", column)] if column in with_paper else [column])]
+    header = [*row_keys, *("paper" if isinstance(key, tuple) else f"{column_key}={key}" for key in keys)]
+    body = [[*label, *(values.get(key, "") for key in keys)] for label, values in cells.items()]
     return f"{' / '.join(METRIC_LABELS.get(m, m) for m in metrics)}\n\n" + _markdown(header, body)
 
 
-def metrics_table(rows: Sequence[Mapping], row_keys: Sequence[str], metrics: Sequence[str]) -> str:
-    """A table with a row per row of `rows` and a column per metric."""
+def metrics_table(rows: Sequence[Mapping], row_keys: Sequence[str], metrics: Sequence[str],
+                  paper: PaperCell | None = None) -> str:
+    """A table with a row per row of `rows` and a column per metric; with `paper` (when it has any value) a last
+    column of the paper's values of the same metrics."""
+    body = [[*_row_label(row, row_keys), *(format_value(row, m) for m in metrics)] for row in rows]
     header = [*row_keys, *(METRIC_LABELS.get(metric, metric) for metric in metrics)]
-    return _markdown(header, [[*_row_label(row, row_keys), *(format_value(row, m) for m in metrics)]
-                              for row in rows])
+    paper_values = [None if paper is None else paper(row, None) for row in rows]
+    if any(value is not None for value in paper_values):
+        header.append("paper")
+        body = [cells + [value or ""] for cells, value in zip(body, paper_values)]
+    return _markdown(header, body)
 
 
 def _sort_key(value):
@@ -110,39 +126,92 @@ def _largest_size(rows):
     return max(sizes) if sizes else None
 
 
+_STATISTICS_NOTE = ("Mean over seeds ± standard error: a bootstrap over the test split's push sequences combined with "
+                    "the spread over seeds (`pushjax.paper.statistics`).\n\n")
+
+
+def _paper_cells(name: str, sizes: Sequence[int], metrics: Sequence[str], size_from_column: bool = False,
+                 l_from_column: bool = False) -> PaperCell:
+    """The `PaperCell` of experiment `name`'s table whose columns are training sizes or ``l`` factors."""
+    def paper(row: Mapping, column) -> str | None:
+        size = column if size_from_column else row.get("train_size")
+        l_scale = column if l_from_column else row.get("l_scale", 1.0)
+        return reference.cell(name, row["model"], reference.size_role(size, sizes), metrics, l_scale)
+    return paper
+
+
+def _paper_notes(name: str) -> str:
+    notes = reference.notes(name)
+    return "".join(f"\n- {note}" for note in notes) and "\n**The paper says:**\n" + "".join(
+        f"\n- {note}" for note in notes) + "\n"
+
+
+def curves_table(curves: Sequence[Mapping], train_size: int) -> str:
+    """How far each model trained at `train_size` is from flat: its score (mean of trans. and rot. % of zero, mean
+    over seeds) on its training examples and on validation, at the first checkpoint after the start, at the end,
+    and the change over the last fifth of the steps (negative: still improving)."""
+    by_key: dict[tuple, dict[int, list[float]]] = {}
+    for row in curves:
+        if row["train_size"] == train_size and row.get("l_scale", 1.0) == 1.0:
+            by_key.setdefault((row["model"], row["train_split"], row["split"]), {}).setdefault(row["step"], []).append(
+                (row["trans_percent"] + row["rot_percent"]) / 2.0)
+    body = []
+    for (model, train_split, split), by_step in by_key.items():
+        steps = sorted(by_step)
+        score = {step: sum(values) / len(values) for step, values in by_step.items()}
+        first = steps[1] if len(steps) > 1 else steps[0]
+        fifth = min(steps, key=lambda step: abs(step - 0.8 * steps[-1]))
+        body.append([model, train_split, split, f"{first:,}: {score[first]:.1f}", f"{steps[-1]:,}: {score[steps[-1]]:.1f}",
+                     f"{score[steps[-1]] - score[fifth]:+.1f}"])
+    header = ["model", "train_split", "curve on", "first checkpoint (step: score)", "end (step: score)",
+              "change over the last fifth"]
+    return _markdown(header, body)
+
+
 def markdown(results: Mapping) -> str:
-    """The paper-style tables of one experiment's results (layout chosen by ``results["name"]``)."""
+    """The paper-style tables of one experiment's results (layout chosen by ``results["name"]``), each with the
+    paper's values beside ours where the paper gives them (`pushjax.paper.reference`)."""
     name, rows = results["name"], aggregate(results["rows"])
     config = results["config"]
     testbed = config.get("testbed", "ideal")  # results written before testbed profiles existed are ideal's
-    title = (f"# {name} ({config['experiment']} dataset, {config['scale']} scale, {testbed} testbed, "
-             f"seeds {config['seeds']})\n\n")
     trained = [row for row in rows if row["kind"] == "trained"]
+    sizes = sorted({row["train_size"] for row in trained})
+    title = (f"# {name} ({config['experiment']} dataset, {config['scale']} scale, {testbed} testbed, "
+             f"seeds {config['seeds']})\n\n" + _STATISTICS_NOTE)
+    if reference.tables():
+        title += (f"A *paper* column gives the paper's value of the cell to its left, where the paper has one; "
+                  f"our largest training size ({max(sizes, default='–')}) stands for the paper's largest.\n\n")
     overall = ("trans_percent", "rot_percent", "pos_mm")
+    errors = ("trans_percent", "rot_percent")
     if name == "data_efficiency":
         largest = [row for row in trained if row["train_size"] == _largest_size(trained)]
         return title + "\n\n".join([
-            "## Table 1: errors by training-set size\n\n" + pivot_table(rows, ["model"], "train_size"),
+            "## Table 1: errors by training-set size\n\n"
+            + pivot_table(rows, ["model"], "train_size", paper=_paper_cells(name, sizes, errors, size_from_column=True)),
             f"## Table 2: state errors at {_largest_size(trained)} training examples\n\n"
-            + metrics_table(largest, ["model"], STATE_METRICS),
+            + metrics_table(largest, ["model"], STATE_METRICS, paper=_paper_cells(name, sizes, STATE_METRICS)),
+            *([f"## Learning curves at {_largest_size(trained)} training examples\n\n"
+               + curves_table(results["curves"], _largest_size(trained))] if results.get("curves") else []),
         ]) + "\n"
     if name in ("velocities", "error_velocities", "objects"):
         figure = {"velocities": "Fig. 6", "error_velocities": "Fig. 9", "objects": "Fig. 7"}[name]
         return title + f"## {figure}: errors per test set\n\n" + pivot_table(
-            rows, ["model", "train_split", "train_size"], "test_split") + "\n"
+            rows, ["model", "train_split", "train_size"], "test_split") + "\n" + _paper_notes(name)
     if name == "error_variants":
         unscaled = [row for row in rows if row["l_scale"] == 1.0]
         scaled = [row for row in rows if row["model"] in ("physics", "hybrid", "error")]
         return title + "\n\n".join([
             "## Table 4: error-term variants by training-set size\n\n"
-            + pivot_table([r for r in unscaled if r["model"] != "physics"], ["model"], "train_size"),
+            + pivot_table([r for r in unscaled if r["model"] != "physics"], ["model"], "train_size",
+                          paper=_paper_cells(name, sizes, errors, size_from_column=True)),
             "## Table 5: wrong limit-surface ratio l (factor of the true value)\n\n"
-            + pivot_table(scaled, ["model", "train_size"], "l_scale"),
+            + pivot_table(scaled, ["model", "train_size"], "l_scale",
+                          paper=_paper_cells(name, sizes, errors, l_from_column=True)),
         ]) + "\n"
     heading = {"new_pushes": "Table 3: new pushes", "viewpoint": "Sec. V: free camera with point clouds",
                "visualize": "Errors on the repeated push (Figs. 7-8)"}
     return title + f"## {heading.get(name, name)}\n\n" + metrics_table(
-        rows, ["model", "train_size", "test_split"], overall) + "\n"
+        rows, ["model", "train_size", "test_split"], overall, paper=_paper_cells(name, sizes, overall)) + "\n"
 
 
 def write(results: Mapping, workdir: str | os.PathLike) -> Path:

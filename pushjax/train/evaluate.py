@@ -7,7 +7,8 @@
   sequences (`sequence_bootstrap_weights`: the ratio of summed errors to summed zero errors over
   resampled sequences), and the per-sequence sums are returned under ``sequences`` so that results can
   be averaged over seeds and compared pairwise on the same resamples (`pushjax.paper.statistics`).
-  Without ``sequence_id`` the examples count as independent.
+  Without ``sequence_id``, or with a single sequence (the ``repeated`` push under many scene transforms), the
+  examples count as independent.
 * ``pos_mm``: object-position error [mm].
 * Physical state errors of the hybrid, simple and error variants on examples with contact:
   ``contact_mm`` (contact point), ``normal_deg`` (surface normal), ``s`` (|s - contact flag|, all
@@ -159,10 +160,10 @@ def error_metrics(predictions: Mapping[str, np.ndarray], examples: Examples) -> 
         metrics["pos_mm"], metrics["pos_mm_se"] = _mean_and_se(per_example["pos_mm"])
     if "sequence_id" in examples:
         sequences = _sequence_sums(examples["sequence_id"], **per_example)
-        for metric in SEQUENCE_RATIOS:
-            if f"{metric}_se" in metrics:
-                replicates = bootstrap_replicates(sequences, metric)
-                metrics[f"{metric}_se"] = float(replicates.std(ddof=1)) if len(sequences["id"]) > 1 else float("nan")
+        if len(sequences["id"]) > 1:
+            for metric in SEQUENCE_RATIOS:
+                if f"{metric}_se" in metrics:
+                    metrics[f"{metric}_se"] = float(bootstrap_replicates(sequences, metric).std(ddof=1))
         metrics["sequences"] = sequences
     touching = np.asarray(examples["contact_flag"]) > 0.5
     if "contact" in predictions:

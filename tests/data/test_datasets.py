@@ -46,7 +46,7 @@ def _all(source):
 
 def test_fields_shapes_and_dtypes(smoke):
     sources = smoke("data_efficiency")
-    assert set(sources) == {"train", "test"}
+    assert set(sources) == {"train", "validation", "test"}
     size = configs.get_config("data_efficiency", "smoke").image_size
     for source in sources.values():
         example = source[0]
@@ -275,7 +275,11 @@ def test_paper_scale_sizes():
         plan = configs.plan_splits(config, "/unused")
         return {name: len(ids) * config.examples_per_sequence for name, ids in plan.splits.items()}
 
-    assert sizes("data_efficiency") == pytest.approx({"train": 190e3, "test": 38e3}, rel=0.03)
+    data_efficiency = sizes("data_efficiency")
+    assert {name: data_efficiency[name] for name in ("train", "test")} == pytest.approx(
+        {"train": 190e3, "test": 38e3}, rel=0.03)
+    # 48 validation sequences per object, 7 for each triangle (its MIT grid has 297 distinct pushes, 290 in use).
+    assert data_efficiency["validation"] == (8 * 48 + 3 * 7) * 72
     assert sizes("new_pushes") == pytest.approx({"train": 114e3, "validation": 23e3, "test": 91e3}, rel=0.03)
     assert all(size == pytest.approx(35e3, rel=0.03)
                for name, size in sizes("objects").items() if name.startswith("train"))

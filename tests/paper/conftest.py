@@ -9,12 +9,15 @@ import importlib
 import pytest
 from absl import flags
 
+from tests.conftest import once_across_workers
+
 SMOKE = ("--scale=smoke", "--num_steps=2")
 RUNS = {
     # binary: (datasets it reads, its flags besides SMOKE, --workdir and --data_dir)
     "data_efficiency": (("data_efficiency",), ("--sizes=20,1000000", "--variants=hybrid,neural_dyn,zero,physics")),
     "new_pushes": (("new_pushes",), ("--sizes=50", "--variants=hybrid,zero")),
     "velocities": (("velocities",), ("--variants=hybrid,physics",)),
+    "error_velocities": (("velocities",), ("--variants=error,error_norm,physics",)),
     "objects": (("objects",), ("--variants=hybrid,zero",)),
     "error_variants": (("data_efficiency",), ("--sizes=50", "--variants=error,error_grad,physics")),
     "viewpoint": (("viewpoint",), ("--sizes=50",)),
@@ -34,9 +37,11 @@ def run_binary(name, *arguments):
 
 
 @pytest.fixture(scope="session")
-def smoke_results(smoke_data, tmp_path_factory):
-    """binary name -> the work directory of its smoke run (run on first request); the parent holds them all."""
-    results_dir = tmp_path_factory.mktemp("results")
+def smoke_results(smoke_data, shared_folder):
+    """binary name -> the work directory of its smoke run (run once per test run, by whichever worker asks first);
+    the parent holds them all."""
+    results_dir = shared_folder / "results"
+    results_dir.mkdir(exist_ok=True)
 
     @functools.cache
     def run(name):
@@ -44,7 +49,7 @@ def smoke_results(smoke_data, tmp_path_factory):
         for experiment in experiments:
             smoke_data(experiment)
         workdir = results_dir / name
-        run_binary(name, *SMOKE, f"--data_dir={smoke_data(experiments[0])}", f"--workdir={workdir}", *arguments)
-        return workdir
+        return once_across_workers(workdir, lambda: run_binary(
+            name, *SMOKE, f"--data_dir={smoke_data(experiments[0])}", f"--workdir={workdir}", *arguments))
 
     return run

@@ -11,7 +11,7 @@ from pushjax.train import configs as train_configs
 
 def test_every_binary_has_a_setup_whose_models_are_known():
     assert set(spec_lib.SETUPS) == {"data_efficiency", "new_pushes", "velocities", "objects", "error_variants",
-                                    "viewpoint", "visualize"}
+                                    "viewpoint", "visualize", "error_velocities"}
     for setup in spec_lib.SETUPS.values():
         assert spec_lib.parse_models(setup.models) == setup.models
 
@@ -86,7 +86,7 @@ def test_unknown_scale_is_rejected():
 
 @pytest.mark.parametrize("splits, message", [
     (dict(train_splits=("bogus",)),
-     r"^train_split: 'bogus' is not a split of data_efficiency; choose from train, test$"),
+     r"^train_split: 'bogus' is not a split of data_efficiency; choose from train, validation, test$"),
     (dict(test_splits=("train_20",)), r"^test_split: 'train_20' is not a split of data_efficiency"),
 ])
 def test_unknown_splits_are_rejected_before_any_data_is_read(splits, message):

@@ -1,10 +1,11 @@
 """Seed aggregation and table layout of pushjax.paper.tables, on hand-made rows."""
 
+import json
 import math
 
 import pytest
 
-from pushjax.paper import tables
+from pushjax.paper import reference, tables
 
 
 def _row(model, size, seed, trans, trans_se):
@@ -17,8 +18,12 @@ def test_aggregate_averages_seeds_and_combines_standard_errors():
     [row] = tables.aggregate([_row("hybrid", 100, 0, 10.0, 3.0), _row("hybrid", 100, 1, 20.0, 4.0)])
     assert row["seeds"] == [0, 1]
     assert row["trans_percent"] == pytest.approx(15.0)
-    assert row["trans_percent_se"] == pytest.approx(math.sqrt(9 + 16) / 2)
-    assert row["rot_percent_se"] is None
+    # Rows without per-sequence sums: their own errors stand for the test set's (one test set: averaged, not
+    # shrunk), the seeds' spread is sd / sqrt(2) = 5.
+    assert row["trans_percent_se_sequences"] == pytest.approx(3.5)
+    assert row["trans_percent_se_seeds"] == pytest.approx(5.0)
+    assert row["trans_percent_se"] == pytest.approx(math.hypot(3.5, 5.0))
+    assert row["rot_percent_se_sequences"] is None and row["rot_percent_se"] == pytest.approx(10.0)
 
 
 def test_pivot_table_repeats_baselines_in_every_size_column():
@@ -27,3 +32,35 @@ def test_pivot_table_repeats_baselines_in_every_size_column():
     assert "| model | train_size=100 | train_size=2500 |" in table
     assert "| zero | 100.0 ± 1.0 / 200.0 | 100.0 ± 1.0 / 200.0 |" in table
     assert "| hybrid | 10.0 ± 1.0 / 20.0 | 5.0 ± 0.5 / 10.0 |" in table
+
+
+_PAPER = {"table1_data_efficiency": {"2500": {"hybrid": {"trans": [25.4, 0.17], "rot": [45.5, 0.36]}},
+                                     "190000": {"hybrid": {"trans": [19.3, 0.13], "rot": [36.1, 0.3]}},
+                                     "physics": {"trans": [18.95, 0.13], "rot": [35.4, 0.3]}},
+          "table2_state_errors_190k": {"hybrid": {"contact_mm": [4.4, 0.01], "normal_deg": [3.6, 0.024]}}}
+
+
+def _data_efficiency_results():
+    rows = [_row("physics", None, None, 20.0, 1.0), _row("hybrid", 2500, 0, 30.0, 1.0),
+            _row("hybrid", 19800, 0, 22.0, 1.0)]
+    return {"name": "data_efficiency", "rows": rows,
+            "config": {"experiment": "data_efficiency", "scale": "cpu", "testbed": "realistic", "seeds": [0]}}
+
+
+def test_tables_put_the_papers_value_beside_ours(tmp_path, monkeypatch):
+    paper = tmp_path / "paper_tables.json"
+    paper.write_text(json.dumps(_PAPER))
+    monkeypatch.setenv(reference.ENVIRONMENT_VARIABLE, str(paper))
+    table = tables.markdown(_data_efficiency_results())
+    assert "| model | train_size=2500 | paper | train_size=19800 | paper |" in table
+    # Our largest size stands for the paper's 190 k; the baseline's paper value fills every column.
+    assert "| hybrid | 30.0 ± 1.0 / 60.0 | 25.4 / 45.5 | 22.0 ± 1.0 / 44.0 | 19.3 / 36.1 |" in table
+    assert "| physics | 20.0 ± 1.0 / 40.0 | 18.95 / 35.4 | 20.0 ± 1.0 / 40.0 | 18.95 / 35.4 |" in table
+    assert "| hybrid | – | – | – | – | – | – / 4.4 / 3.6 / – / – |" in table
+
+
+def test_tables_without_the_papers_file_have_no_paper_column(tmp_path, monkeypatch):
+    monkeypatch.setenv(reference.ENVIRONMENT_VARIABLE, str(tmp_path / "absent.json"))
+    assert reference.tables() == {}
+    table = tables.markdown(_data_efficiency_results())
+    assert "paper" not in table.replace("pushjax.paper", "")
