@@ -4,8 +4,8 @@
 #   bash scripts/results.sh [RUNS_DIR]      (default: work/results; SEEDS=0,1,2 and SCALE=cpu by default)
 #
 # Resumable: stop it at any time and run it again. Training resumes from each sweep's last checkpoint, and an
-# experiment whose `<RUNS_DIR>/<name>/results.json` exists is not run again (delete that file to redo its tables;
-# its finished sweeps are reused). Each run's log is `<RUNS_DIR>/<name>.log`; every results.json records the git
+# experiment this script finished (marked by `<RUNS_DIR>/<name>.done`) is not run again (delete the marker to redo
+# its tables; its finished sweeps are reused). Each run's log is `<RUNS_DIR>/<name>.log`; every results.json records the git
 # commit and the wall time of every sitting (`provenance`).
 #
 # Sweeps that two experiments share are trained once: error_variants at l = 1 is data_efficiency's hybrid and
@@ -21,11 +21,12 @@ python=${PYTHON:-.venv/bin/python}
 
 run() {
   local name=$1; shift
-  if [[ -f "$runs/$name/results.json" ]]; then echo "$name: done ($runs/$name/results.json)"; return; fi
+  if [[ -f "$runs/$name.done" ]]; then echo "$name: done ($runs/$name/results.json)"; return; fi
   echo "$name: running (log $runs/$name.log)"
   mkdir -p "$runs/$name"
   "$python" -m experiments."$name" --workdir="$runs/$name" --scale="$scale" --seeds="$seeds" "$@" \
     >> "$runs/$name.log" 2>&1
+  touch "$runs/$name.done"
 }
 share() {  # share FROM TO SWEEP...: copy finished sweeps of experiment FROM into experiment TO
   local from=$1 to=$2; shift 2
