@@ -199,7 +199,8 @@ class Effect:
       init: the "no effect" parameters, {name: zeros of the parameter's shape}.
       typical: {name: typical magnitude}, for conditioning optimisers.
       modify: (params, state, inputs) -> state, applied before the solve, or None.
-      correct: (params, twist, state, inputs) -> twist, applied to the predicted twist, or None.
+      correct: (params, twist, state, inputs) -> twist, applied to the predicted twist of the push, or None;
+        with several, their changes add up (each sees the push's twist, not another's correction).
       project: params -> params inside the physically valid set.
       physical: params -> {readable name with unit: scalar}, the values to report.
       general_solver: whether the effect needs the generalised solver (not plain Lynch).
@@ -608,9 +609,12 @@ def compose(names: Sequence[str]) -> Callable[[dict[str, Params], PushInputs], j
         omega = twist[..., 2]
         twist = jnp.stack([twist[..., 0] + omega * state.centre[..., 1],
                            twist[..., 1] - omega * state.centre[..., 0], omega], axis=-1)
+        # Corrections (the slide after the pusher stops) start from the twist of the push itself and add up: a
+        # slide is driven by the speed the push gave the object, not by another correction's slide.
+        pushed = twist
         for name in names:
             if EFFECTS[name].correct is not None:
-                twist = EFFECTS[name].correct(params_by_effect[name], twist, state, inputs)
+                twist = twist + (EFFECTS[name].correct(params_by_effect[name], pushed, state, inputs) - pushed)
         return twist
 
     return predict
