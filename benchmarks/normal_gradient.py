@@ -154,7 +154,7 @@ def main(argv):
     spec = spec_lib.make_spec(setup, _SCALE.value, sizes=_SIZES.value, seeds=_SEEDS.value,
                               num_steps=_NUM_STEPS.value, testbed=_TESTBED.value)
     source = runner.load_splits(spec, spec.dataset, progress=False)["train"]
-    examples = examples_from_source(source, (*spec.example_fields(), "action_from_contact"))
+    examples = examples_from_source(source, tuple(dict.fromkeys((*spec.example_fields(), "action_from_contact"))))
     result = runner.train_sweep(spec, (_VARIANT.value,), examples, f"{_WORKDIR.value}/train/l1/{_VARIANT.value}")
     train = spec.train_config(_VARIANT.value)
     error_options = (jnp.asarray(ERROR_OPTIONS[_VARIANT.value], jnp.float32) if _VARIANT.value in ERROR_OPTIONS
