@@ -18,7 +18,8 @@ class TrainConfig:
       model: the architecture (its `variant` is usually overridden per run).
       learning_rate: Adam step size (the initial one with a decaying schedule).
       schedule: the learning-rate schedule (`pushjax.train.train_state.SCHEDULES`): ``"constant"`` (the paper's) or
-        ``"cosine"`` (decayed over `num_steps`).
+        ``"cosine"`` (decayed over `num_steps`, so resuming a sweep with another `num_steps` changes the rest of its
+        schedule).
       batch_size: examples per step and model.
       num_steps: optimisation steps per model.
       weight_decay: lambda of the 0.5 * |w|^2 kernel penalty.
