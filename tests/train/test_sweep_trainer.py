@@ -114,6 +114,7 @@ def test_killed_training_resumes_to_the_uninterrupted_parameters(mode, examples,
         train.sweep(config, examples, train.subset_specs(256, [30], [5]), tmp_path / "killed", progress=False)
 
 
+@pytest.mark.filterwarnings("ignore:workdir.*past the requested num_steps")  # test_resuming_past_the_requested_steps_warns
 def test_resuming_a_finished_sweep_reports_the_restored_steps(examples, tmp_path):
     config = _config("hybrid", num_steps=6, checkpoint_every=3, log_every=3)
     specs = train.subset_specs(256, [30], [1, 2])
