@@ -11,7 +11,7 @@ from tests.tiny_configs import TINY_SMOKE
 
 
 def _sweep(config, examples, validation, workdir):
-    specs = train.subset_specs(len(examples["motion"]), [100], [0, 1])
+    specs = train.subset_specs(len(examples["motion"]), [100], [0])
     learning_curves = curves.LearningCurves(workdir / "curves.csv", PushModel(config.model), specs, examples,
                                             {"validation": validation}, max_examples=32, batch_size=32)
     return train.sweep(config, examples, specs, workdir, mode="sequential", progress=False,
@@ -20,13 +20,12 @@ def _sweep(config, examples, validation, workdir):
 
 def test_curves_at_every_checkpoint_and_resume_to_the_same_file(smoke, tmp_path):
     config = dataclasses.replace(TINY_SMOKE.with_variant("hybrid"), num_steps=40, checkpoint_every=20,
-                                 learning_rate=3e-3)
+                                 learning_rate=3e-3, log_every=20)
     examples, validation = smoke["train"], smoke["validation"]
     _sweep(config, examples, validation, tmp_path / "whole")
     rows = curves.read(tmp_path / "whole" / "curves.csv")
     assert sorted({row["step"] for row in rows}) == [0, 20, 40]
-    assert {(row["model"], row["split"]) for row in rows} == {(k, split) for k in (0, 1)
-                                                             for split in ("train", "validation")}
+    assert {(row["model"], row["split"]) for row in rows} == {(0, "train"), (0, "validation")}
     assert all(np.isfinite(row["trans_percent"]) and row["rot_percent"] > 0 for row in rows)
     first = {(row["model"], row["split"]): row["trans_percent"] for row in rows if row["step"] == 0}
     last = {(row["model"], row["split"]): row["trans_percent"] for row in rows if row["step"] == 40}
