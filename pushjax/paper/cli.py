@@ -13,7 +13,7 @@ import warnings
 from absl import app, flags, logging
 
 from pushjax.data import configs as data_configs
-from pushjax.paper import figures, paths, runner, spec as spec_lib, tables, visualize
+from pushjax.paper import figures, paths, reference, runner, spec as spec_lib, tables, visualize
 from pushjax.sim import testbed
 from pushjax.train import SWEEP_MODES, distributed
 
@@ -82,6 +82,10 @@ def main(name: str, argv) -> dict:
     """Runs experiment `name` (`spec_lib.SETUPS`) with the parsed flags; writes results, tables and figures."""
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {argv[1:]}")
+    try:  # read before training, so that a bad file stops the run at once and not after hours
+        reference.tables()
+    except ValueError as error:
+        raise app.UsageError(str(error)) from error
     outcome = run_spec(spec_from_flags(spec_lib.SETUPS[name]))
     if not distributed.is_writer():  # process 0 of several writes and prints
         return outcome.results

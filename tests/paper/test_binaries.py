@@ -128,3 +128,12 @@ def test_binaries_end_with_what_they_wrote_where(smoke_data, tmp_path, capsys, b
 def test_visualize(smoke_results):
     tmp_path = smoke_results("visualize")
     _check_results(tmp_path, "visualize", ("hybrid", "neural"), ["fig8_repeated_pushes.png"])
+
+
+def test_unreadable_paper_tables_stop_the_run_before_training(tmp_path, monkeypatch):
+    bad = tmp_path / "paper_tables.json"
+    bad.write_text("not json")
+    monkeypatch.setenv("PUSHJAX_PAPER_TABLES", str(bad))
+    with pytest.raises(app.UsageError, match=f"^PUSHJAX_PAPER_TABLES: {bad} is not a readable JSON file"):
+        run_binary("data_efficiency", "--scale=smoke", f"--workdir={tmp_path / 'work'}", "--nobuild")
+    assert not (tmp_path / "work").exists()
