@@ -70,7 +70,8 @@ def _entry(experiment: str, model: str, size_role: str | None, l_scale: float) -
 
 
 def size_role(size: int | None, sizes: Sequence[int]) -> str | None:
-    """``"small"`` for 2 500, ``"largest"`` for the largest of `sizes`, None for a baseline or another size."""
+    """``"small"`` for 2 500, ``"largest"`` for the largest of `sizes`, ``""`` for another size, None for a baseline
+    (no size)."""
     if size is None:
         return None
     if size == 2500:

@@ -142,8 +142,7 @@ def _paper_cells(name: str, sizes: Sequence[int], metrics: Sequence[str], size_f
 
 def _paper_notes(name: str) -> str:
     notes = reference.notes(name)
-    return "".join(f"\n- {note}" for note in notes) and "\n**The paper says:**\n" + "".join(
-        f"\n- {note}" for note in notes) + "\n"
+    return "\n**The paper says:**\n" + "".join(f"\n- {note}" for note in notes) + "\n" if notes else ""
 
 
 def curves_table(curves: Sequence[Mapping], train_size: int) -> str:
