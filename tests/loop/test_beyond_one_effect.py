@@ -1,0 +1,33 @@
+"""The loop beyond one library effect: two undeclared effects at once, none, and one outside the library
+(see test_undeclared_effects.py; a file of its own so that the cases run on two pytest-xdist workers)."""
+
+import json
+
+from .conftest import combined
+
+
+def test_two_effects_at_once_are_both_selected_and_beat_either_alone(loop_report):
+    report, workdir = loop_report("com_offset_and_pusher_friction")
+    first, second = report["selected"][:2]
+    assert {first, second} & {"cof_offset", "pressure_gradient"} and "pusher_friction" in {first, second}
+    # On the select split: the pair's error is below that of either effect fitted alone.
+    alone = {entry["effect"]: combined(entry["select"]) for entry in report["ranking"]}
+    rounds = json.loads((workdir / "details.json").read_text())["rounds"]
+    pair = alone[first] * (1 - rounds[1]["gains"][second])
+    assert pair < min(alone[first], alone[second])
+    assert combined(report["after"]) <= 0.5 * combined(report["baseline"])
+
+
+def test_clean_data_selects_nothing(loop_report):
+    report, _ = loop_report("clean")
+    assert report["selected"] == []
+    assert report["after"] == report["baseline"]
+
+
+def test_effect_outside_the_library_is_unexplained_and_the_fallback_helps(loop_report):
+    report, workdir = loop_report("tracking_yaw_bias")
+    assert report["explained"] is False
+    variable = report["remaining"][0]["variable"]
+    assert variable in {d["variable"] for d in report["diagnosis"]} and report["remaining"][0]["strength"] > 0.1
+    assert variable in (workdir / "report.md").read_text()
+    assert combined(report["fallback"]) < 0.9 * combined(report["after"])
