@@ -48,7 +48,7 @@ def main():
         start = time.perf_counter()
         report = close_loop(data_dir, workdir, seed=args.seed)
         elapsed = time.perf_counter() - start
-    pushes = report["n_pushes"]["fit"] + report["n_pushes"]["heldout"]
+    pushes = len(recorded.written) + len(recorded.skipped)
     print(json.dumps({key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "explained")},
                      indent=1))
     print(f"close_loop on {pushes} pushes: {elapsed:.1f} s")
