@@ -47,11 +47,6 @@ PUSHES = 120
 from the MIT grid."""
 
 
-def combined(summary):
-    """Translation % + rotation % of the ``zero`` baseline: the score the loop selects by."""
-    return summary["trans_pct"] + summary["rot_pct"]
-
-
 @pytest.fixture(scope="session")
 def record(tmp_path_factory):
     """record(name) -> root of the data set ``CASES[name]`` (recorded on first use)."""

@@ -3,7 +3,7 @@
 
 import json
 
-from .conftest import combined
+from pushjax.loop.metrics import combined
 
 
 def test_two_effects_at_once_are_both_selected_and_beat_either_alone(loop_report):

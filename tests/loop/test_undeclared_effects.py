@@ -11,9 +11,10 @@ import json
 import numpy as np
 import pytest
 
+from pushjax.loop.metrics import combined
 from pushjax.physics.effects import EFFECT_NAMES
 
-from .conftest import CASES, combined
+from .conftest import CASES
 
 SUMMARY_KEYS = {"trans_pct", "rot_pct", "trans_mm", "rot_deg"}
 SINGLE = [name for name, case in CASES.items() if case.expected and "_and_" not in name]
