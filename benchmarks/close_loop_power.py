@@ -17,7 +17,9 @@ Criteria, fixed before measuring:
     python benchmarks/close_loop_power.py [--data_dir /tmp/close_loop_power/data] [--seeds 5] [--cases clean,...]
 
 ``--cases`` analyses only the named cases (e.g. ``--cases clean --seeds 12`` for more clean data sets); the goal
-line then judges only the parts of the goal those cases measure.
+line then judges only the parts of the goal those cases measure. ``--cross_fit_below N`` overrides
+``pushjax.loop.splits.CROSS_FIT_BELOW`` for this run (0: always a single fit/select split), to compare the
+cross-fitted selection with the single split on the same data.
 """
 
 import argparse
@@ -78,7 +80,12 @@ def main():
     parser.add_argument("--data_dir", type=Path, default=Path("/tmp/close_loop_power/data"))
     parser.add_argument("--seeds", type=int, default=5)
     parser.add_argument("--cases", default=",".join(CASES), help="comma-separated cases to analyse (default: all)")
+    parser.add_argument("--cross_fit_below", type=int, default=splits.CROSS_FIT_BELOW,
+                        help="select sequences below which the loop cross-fits (the library's value by default)")
     args = parser.parse_args()
+    if args.cross_fit_below < 0:
+        parser.error(f"--cross_fit_below: expected >= 0, got {args.cross_fit_below}")
+    splits.CROSS_FIT_BELOW = args.cross_fit_below
     cases = args.cases.split(",")
     if unknown := sorted(set(cases) - set(CASES)):
         parser.error(f"--cases: unknown {', '.join(unknown)}; expected some of {', '.join(CASES)}")
