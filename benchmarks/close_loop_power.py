@@ -15,11 +15,14 @@ Criteria, fixed before measuring:
   * goal: power >= 90 % at 200 pushes for every case whose added error is >= 20 %; false discoveries <= 5 %.
 
     python benchmarks/close_loop_power.py [--data_dir /tmp/close_loop_power/data] [--seeds 5] [--cases clean,...]
+        [--start_poses fixed|scattered]
 
 ``--cases`` analyses only the named cases (e.g. ``--cases clean --seeds 12`` for more clean data sets); the goal
 line then judges only the parts of the goal those cases measure. ``--cross_fit_below N`` overrides
 ``pushjax.loop.splits.CROSS_FIT_BELOW`` for this run (0: always a single fit/select split), to compare the
-cross-fitted selection with the single split on the same data.
+cross-fitted selection with the single split on the same data. ``--start_poses scattered`` records every push from
+its own drawn pose (``pushjax.sim.dataset.START_POSES``) instead of the MIT protocol's one pose; it needs a
+``--data_dir`` of its own (a folder keeps the settings it was recorded with).
 """
 
 import argparse
@@ -34,7 +37,7 @@ from pushjax.loop import metrics, select, splits
 from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes
 from pushjax.physics.effects import EFFECT_NAMES
-from pushjax.sim.dataset import record_pushes
+from pushjax.sim.dataset import START_POSES, record_pushes
 from pushjax.sim.effects import Effects
 
 CASES = {
@@ -58,13 +61,13 @@ SIZES = (200, 100)
 POWER_GOAL, FALSE_DISCOVERY_GOAL, ADDED_ERROR_FOR_GOAL = 0.9, 0.05, 0.2
 
 
-def record(data_dir: Path, seeds: int, cases: list[str]) -> None:
+def record(data_dir: Path, seeds: int, cases: list[str], start_poses: str) -> None:
     for seed in range(seeds):
         for name in cases:
             effects = CASES[name]
             record_pushes(data_dir / name / f"seed{seed}", OBJECTS, SURFACES, PUSHES_PER_OBJECT, seed=seed,
                           velocities=VELOCITIES, effects=Effects.parse(effects), declare_effects=False, workers=1,
-                          progress=False)
+                          progress=False, start_poses=start_poses)
 
 
 def subsample(examples, pushes: int, seed: int):
@@ -82,6 +85,8 @@ def main():
     parser.add_argument("--cases", default=",".join(CASES), help="comma-separated cases to analyse (default: all)")
     parser.add_argument("--cross_fit_below", type=int, default=splits.CROSS_FIT_BELOW,
                         help="select sequences below which the loop cross-fits (the library's value by default)")
+    parser.add_argument("--start_poses", choices=START_POSES, default="fixed",
+                        help="where the recorded pushes start (fixed: the MIT protocol's one pose)")
     args = parser.parse_args()
     if args.cross_fit_below < 0:
         parser.error(f"--cross_fit_below: expected >= 0, got {args.cross_fit_below}")
@@ -92,7 +97,7 @@ def main():
     if "clean" not in cases:
         parser.error("--cases: expected clean among them (the added error of every case is measured against it)")
     start = time.perf_counter()
-    record(args.data_dir, args.seeds, cases)
+    record(args.data_dir, args.seeds, cases, args.start_poses)
     print(f"recorded (or reused) in {time.perf_counter() - start:.0f} s", flush=True)
     outcomes = collections.defaultdict(list)  # (case, pushes) -> [first selected or None]
     errors = collections.defaultdict(list)  # case -> plain model's score per seed

@@ -3,7 +3,8 @@ r"""Record simulated MIT Push Dataset files (MuJoCo, MIT protocol and raw layout
   python -m experiments.record_pushes --out_dir=/tmp/pushes --objects=rect1,tri2 --surfaces=abs \
       --velocities=20,50 --pushes=100 --seed=0 [--accelerations=0] [--repeats=1] [--workers=2] \
       [--effects='com_offset=0.01,0.0;table_tilt_deg=1.0'] [--declare_effects=false] [--support=grid] \
-      [--testbed=realistic|ideal] [--testbed_overrides='drop_rate=0;friction_field_sigma=0.2']
+      [--testbed=realistic|ideal] [--testbed_overrides='drop_rate=0;friction_field_sigma=0.2'] \
+      [--start_poses=fixed|scattered]
 
 Pushes are drawn from the MIT grid (side, contact point, angle; velocity and acceleration from the flags) and
 written to ``<out_dir>/<surface>/<object>/motion_surface=..._shape=..._a=..._v=..._i=..._s=..._t=...h5``.
@@ -25,6 +26,10 @@ motion-capture system with noise, time-stamp jitter and dropped samples, calibra
 single magnitudes of the profile, ``name=value`` items separated by ``;`` (0 switches a mechanism off), e.g.
 ``--testbed=realistic --testbed_overrides='drop_rate=0;pusher_friction_sigma=0.1'``; the fields are those of
 ``pushjax.sim.testbed.Testbed``.
+
+``--start_poses=scattered`` starts each push from its own drawn pose (position within 0.1 m of the table origin,
+any yaw; ``pushjax.sim.dataset.START_POSES``) instead of the MIT protocol's one pose, so that effects fixed to the
+table can be told from effects fixed to the object.
 """
 
 import math
@@ -33,7 +38,7 @@ from absl import app, flags
 
 import experiments
 from pushjax.geometry import OBJECT_NAMES
-from pushjax.sim.dataset import OutDirConflictError, record_pushes
+from pushjax.sim.dataset import START_POSES, OutDirConflictError, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
 from pushjax.sim.testbed import from_flags
@@ -50,6 +55,10 @@ _DECLARE = flags.DEFINE_bool("declare_effects", True, "Write effects and seed as
 _REPEATS = flags.DEFINE_integer("repeats", 1, "Files per drawn push (_rep=NNNN when > 1).", lower_bound=1)
 _WORKERS = flags.DEFINE_integer("workers", None, "Worker processes (default: all cores).", lower_bound=1)
 _SUPPORT = flags.DEFINE_enum("support", "grid", ["grid", "hull"], "Support points of the object.")
+_START_POSES = flags.DEFINE_enum(
+    "start_poses", "fixed", list(START_POSES),
+    "Where pushes start: fixed (the MIT protocol: every push from the table origin, yaw 0) or scattered (each from "
+    "a drawn position within 0.1 m and yaw).")
 _TESTBED = experiments.define_testbed_flag()
 _TESTBED_OVERRIDES = flags.DEFINE_string(
     "testbed_overrides", "",
@@ -110,7 +119,7 @@ def main(argv):
             accelerations=_numbers("accelerations", _ACCELERATIONS.value, 0.0, strict=False),
             repeats=_REPEATS.value, effects=Effects.parse(_EFFECTS.value), declare_effects=_DECLARE.value,
             support=_SUPPORT.value, testbed=from_flags(_TESTBED.value, _TESTBED_OVERRIDES.value),
-            workers=_WORKERS.value)
+            workers=_WORKERS.value, start_poses=_START_POSES.value)
     except OutDirConflictError as error:
         raise app.UsageError(f"--{error}") from None
     print(f"wrote {len(summary.written)} files ({len(summary.rerecorded)} replacing invalid files), "

@@ -171,6 +171,7 @@ CASES = [
     ("record_pushes", ["--out_dir={tmp}/pushes", "--repeats=0"], "--repeats"),
     ("record_pushes", ["--out_dir={tmp}/pushes", "--workers=0"], "--workers"),
     ("record_pushes", ["--out_dir={tmp}/pushes", "--support=disc"], "--support"),
+    ("record_pushes", ["--out_dir={tmp}/pushes", "--start_poses=random"], "--start_poses"),
     ("record_pushes", ["--out_dir={tmp}/pushes", "--testbed=perfect"], "--testbed"),
     ("record_pushes", ["--out_dir={tmp}/pushes", "--testbed_overrides=drop_rate=2"], "--testbed_overrides"),
     ("record_pushes", ["--out_dir={tmp}/pushes", "--testbed_overrides=wind=1"], "--testbed_overrides"),

@@ -47,6 +47,19 @@ from pushjax.sim.testbed import IDEAL, PushConditions, Testbed, draw_conditions
 _MAX_DRAWS_PER_PUSH = 1000
 """Draws after which a push that keeps hitting already drawn file names gives up."""
 
+START_POSES = ("fixed", "scattered")
+"""Where pushes start: ``fixed`` is the MIT protocol (the object's tracked frame at the table origin, yaw 0, for
+every push); ``scattered`` draws each push's start pose uniformly, the position within
+:data:`START_SCATTER_M` of the origin along each table axis and the yaw over a whole turn, from the push's own
+generator. Scattered starts tell effects fixed to the table (a friction field) from effects fixed to the object
+(a moved centre of mass), which pushes from one pose cannot."""
+
+START_SCATTER_M = 0.1
+"""Half-width (m) of the square of start positions under ``start_poses="scattered"``."""
+
+_START_POSE_STREAM = 1
+"""Appended to a push's key to seed its start-pose generator apart from its push and noise draws."""
+
 MANIFEST_NAME = "pushjax_manifest.json"
 """The file in a :func:`record_pushes` folder that holds the settings its files were recorded with."""
 
@@ -69,6 +82,7 @@ class PushJob:
         :func:`pushjax.sim.testbed.draw_conditions`, whose first element is the data set's seed.
       attributes: the HDF5 attributes to write, or None for a file with the three datasets only.
       testbed: the testbed profile (:mod:`pushjax.sim.testbed`).
+      initial_pose: (x m, y m, yaw rad) of the object's tracked frame when the push starts.
     """
 
     path: Path
@@ -78,6 +92,7 @@ class PushJob:
     noise_seed: tuple[int, ...]
     attributes: dict | None
     testbed: Testbed = IDEAL
+    initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -112,9 +127,11 @@ def plan_pushes(
     declare_effects: bool = True,
     support: str = "grid",
     testbed: Testbed = IDEAL,
+    start_poses: str = "fixed",
 ) -> list[PushJob]:
     """The files to record, in a deterministic order; arguments as in :func:`record_pushes`."""
-    _check_arguments(objects, surfaces, pushes, seed, velocities, accelerations, repeats, effects, support)
+    _check_arguments(objects, surfaces, pushes, seed, velocities, accelerations, repeats, effects, support,
+                     start_poses)
     if not isinstance(testbed, Testbed):
         raise ValueError(f"testbed: expected a Testbed, got {type(testbed).__name__}")
     jobs = []
@@ -136,6 +153,7 @@ def plan_pushes(
                 else:
                     raise ValueError(f"pushes: could not draw {pushes} distinct pushes of {obj} on {surface}")
                 taken.add(push_file_name(params))
+                initial_pose = _start_pose(start_poses, key)
                 for repetition in range(repeats):
                     repeated = dataclasses.replace(params, repetition=repetition if repeats > 1 else None)
                     attributes = None
@@ -147,15 +165,24 @@ def plan_pushes(
                             "pushjax_support": support,
                             "pushjax_object_friction": get_surface(surface).object_friction,
                             "pushjax_pusher_friction": scene.pusher_friction(effects),
-                            "pushjax_initial_pose": np.zeros(3),
+                            "pushjax_initial_pose": np.asarray(initial_pose),
                             "pushjax_simulator": f"mujoco {mujoco.__version__}",
                         }
                         if not testbed.ideal:
                             attributes["pushjax_testbed"] = testbed.to_json()
                     jobs.append(PushJob(
                         path=push_file_path(out_dir, repeated), params=repeated, effects=effects, support=support,
-                        noise_seed=key + (repetition,), attributes=attributes, testbed=testbed))
+                        noise_seed=key + (repetition,), attributes=attributes, testbed=testbed,
+                        initial_pose=initial_pose))
     return jobs
+
+
+def _start_pose(start_poses: str, key: tuple[int, ...]) -> tuple[float, float, float]:
+    if start_poses == "fixed":
+        return (0.0, 0.0, 0.0)
+    rng = np.random.default_rng(key + (_START_POSE_STREAM,))
+    x, y = rng.uniform(-START_SCATTER_M, START_SCATTER_M, size=2)
+    return (float(x), float(y), float(rng.uniform(-math.pi, math.pi)))
 
 
 def job_conditions(job: PushJob) -> PushConditions | None:
@@ -170,8 +197,8 @@ def job_conditions(job: PushJob) -> PushConditions | None:
 def simulate_job(job: PushJob) -> Recording:
     """Simulates one planned push, with its tracking noise and testbed draw, without writing it."""
     rng = np.random.default_rng(job.noise_seed)
-    return simulate_push(dataclasses.replace(job.params, repetition=None), job.effects, job.support, rng=rng,
-                         conditions=job_conditions(job))
+    return simulate_push(dataclasses.replace(job.params, repetition=None), job.effects, job.support,
+                         initial_pose=job.initial_pose, rng=rng, conditions=job_conditions(job))
 
 
 def record_push(job: PushJob) -> Path:
@@ -203,6 +230,7 @@ def record_pushes(
     testbed: Testbed = IDEAL,
     workers: int | None = None,
     progress: bool = True,
+    start_poses: str = "fixed",
 ) -> RecordSummary:
     """Records simulated pushes as MIT raw files under ``out_dir/<surface>/<object>/``.
 
@@ -229,6 +257,7 @@ def record_pushes(
         dataset configs default to the realistic profile).
       workers: worker processes (default: all cores); 1 records in this process.
       progress: show a tqdm progress bar.
+      start_poses: where each push starts, one of :data:`START_POSES` (default ``fixed``, the MIT protocol).
 
     Returns:
       The :class:`RecordSummary`.
@@ -241,9 +270,9 @@ def record_pushes(
     if workers is not None and (not isinstance(workers, int) or workers < 1):
         raise ValueError(f"workers: expected an integer >= 1, got {workers!r}")
     jobs = plan_pushes(out_dir, objects, surfaces, pushes, seed, velocities, accelerations, repeats, effects,
-                       declare_effects, support, testbed)
+                       declare_effects, support, testbed, start_poses)
     _claim_out_dir(Path(out_dir), recording_settings(seed, velocities, accelerations, repeats, effects,
-                                                     declare_effects, support, testbed))
+                                                     declare_effects, support, testbed, start_poses))
     skipped, todo, invalid = [], [], {}
     for job in jobs:
         if not job.path.exists():
@@ -286,12 +315,13 @@ def recording_settings(
     declare_effects: bool,
     support: str,
     testbed: Testbed = IDEAL,
+    start_poses: str = "fixed",
 ) -> dict:
     """The settings that fix the bytes of every file :func:`record_pushes` writes, as JSON values.
 
     Arguments as in :func:`record_pushes` (velocities in mm/s, accelerations in mm/s², both in draw order);
-    ``simulator`` adds the MuJoCo version. A manifest written before testbeds existed has no ``testbed``; it counts
-    as the ideal testbed (:data:`_LEGACY_SETTINGS`).
+    ``simulator`` adds the MuJoCo version. A manifest written before testbeds (or start poses) existed has no
+    ``testbed`` (``start_poses``); it counts as the ideal testbed (fixed starts): :data:`_LEGACY_SETTINGS`.
     """
     return {
         "seed": int(seed),
@@ -302,11 +332,12 @@ def recording_settings(
         "declare_effects": bool(declare_effects),
         "support": support,
         "testbed": testbed.to_dict(),
+        "start_poses": start_poses,
         "simulator": f"mujoco {mujoco.__version__}",
     }
 
 
-_LEGACY_SETTINGS = {"testbed": IDEAL.to_dict()}
+_LEGACY_SETTINGS = {"testbed": IDEAL.to_dict(), "start_poses": "fixed"}
 """Settings that manifests written before they existed hold implicitly."""
 
 
@@ -356,7 +387,10 @@ def _claim_out_dir(out_dir: Path, settings: dict) -> None:
             "record into another folder or use the recorded settings")
 
 
-def _check_arguments(objects, surfaces, pushes, seed, velocities, accelerations, repeats, effects, support):
+def _check_arguments(objects, surfaces, pushes, seed, velocities, accelerations, repeats, effects, support,
+                     start_poses):
+    if start_poses not in START_POSES:
+        raise ValueError(f"start_poses: expected one of {', '.join(START_POSES)}, got {start_poses!r}")
     for name, values, known in (("objects", objects, OBJECT_NAMES), ("surfaces", surfaces, SURFACE_NAMES)):
         if isinstance(values, str) or not values:
             raise ValueError(f"{name}: expected a non-empty list of names from {', '.join(known)}, got {values!r}")

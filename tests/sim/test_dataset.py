@@ -166,11 +166,37 @@ def test_plan_draws_distinct_pushes_and_checks_arguments(tmp_path):
         (dict(objects=["cube"]), "objects"), (dict(surfaces=["ice"]), "surfaces"), (dict(pushes=0), "pushes"),
         (dict(velocities=(0.0,)), "velocities"), (dict(accelerations=(-1.0,)), "accelerations"),
         (dict(repeats=0), "repeats"), (dict(support="ring"), "support"), (dict(objects="rect1"), "objects"),
+        (dict(start_poses="random"), "start_poses"),
     ]:
         with pytest.raises(ValueError, match=message):
             dataset.plan_pushes(tmp_path, **{"objects": ["rect1"], "surfaces": ["abs"], "pushes": 1, **arguments})
     with pytest.raises(ValueError, match="workers"):
         dataset.record_pushes(tmp_path, ["rect1"], ["abs"], 1, workers=0)
+
+
+def test_scattered_start_poses_move_each_push_to_its_own_drawn_pose(tmp_path):
+    fixed = dataset.plan_pushes(tmp_path, ["tri1"], ["abs"], pushes=40, velocities=(20.0,))
+    scattered = dataset.plan_pushes(tmp_path, ["tri1"], ["abs"], pushes=40, velocities=(20.0,), start_poses="scattered")
+    assert [job.path for job in scattered] == [job.path for job in fixed]  # the same pushes, other places
+    assert all(job.initial_pose == (0.0, 0.0, 0.0) for job in fixed)
+    poses = np.array([job.initial_pose for job in scattered])
+    assert np.all(np.abs(poses[:, :2]) <= dataset.START_SCATTER_M) and np.all(np.abs(poses[:, 2]) <= np.pi)
+    assert np.ptp(poses[:, 2]) > np.pi and np.ptp(poses[:, 0]) > dataset.START_SCATTER_M  # spread, not one place
+    again = dataset.plan_pushes(tmp_path, ["tri1"], ["abs"], pushes=40, velocities=(20.0,), start_poses="scattered")
+    assert [job.initial_pose for job in again] == [job.initial_pose for job in scattered]
+
+    summary = dataset.record_pushes(tmp_path / "pushes", ["tri1"], ["abs"], pushes=2, seed=3, velocities=(20.0,),
+                                    workers=1, progress=False, start_poses="scattered")
+    for path, job in zip(summary.written, dataset.plan_pushes(tmp_path, ["tri1"], ["abs"], 2, seed=3,
+                                                             velocities=(20.0,), start_poses="scattered")):
+        raw = read_raw_push(path)
+        np.testing.assert_allclose(raw.object_pose[0, 1:3], job.initial_pose[:2], atol=1e-3)
+        assert abs(np.angle(np.exp(1j * (raw.object_pose[0, 3] - job.initial_pose[2])))) < 1e-2
+        with h5py.File(path) as file:
+            np.testing.assert_array_equal(file.attrs["pushjax_initial_pose"], job.initial_pose)
+    with pytest.raises(dataset.OutDirConflictError, match="start_poses"):
+        dataset.record_pushes(tmp_path / "pushes", ["tri1"], ["abs"], pushes=2, seed=3, velocities=(20.0,),
+                              workers=1, progress=False)
 
 
 def run_cli(*flags):
