@@ -4,9 +4,12 @@
 #   bash scripts/results.sh [RUNS_DIR]      (default: work/results; SEEDS=0,1,2 and SCALE=cpu by default)
 #
 # Resumable: stop it at any time and run it again. Training resumes from each sweep's last checkpoint, and an
-# experiment this script finished (marked by `<RUNS_DIR>/<name>.done`) is not run again (delete the marker to redo
-# its tables; its finished sweeps are reused). Each run's log is `<RUNS_DIR>/<name>.log`; every results.json records the git
-# commit and the wall time of every sitting (`provenance`).
+# experiment this script finished is not run again. A finished experiment's tables, curves and figures (results.json,
+# results.md, curves.csv, *.png: small files, no checkpoints) are published to `results/<name>/` in the repository,
+# to be committed: RESULTS.md is written from them, and a fresh checkout that lacks RUNS_DIR goes on with the next
+# experiment (delete `results/<name>/` to redo one; its finished sweeps in RUNS_DIR are reused). Each run's log is
+# `<RUNS_DIR>/<name>.log`; every results.json records the git commit and the wall time of every sitting
+# (`provenance`).
 #
 # Sweeps that two experiments share are trained once: error_variants at l = 1 is data_efficiency's hybrid and
 # error-variant sweeps, visualize evaluates data_efficiency's models, error_velocities (Fig. 9) reuses the
@@ -18,15 +21,20 @@ seeds=${SEEDS:-0,1,2}
 scale=${SCALE:-cpu}
 export MUJOCO_GL=${MUJOCO_GL:-egl}
 python=${PYTHON:-.venv/bin/python}
+published=${PUBLISHED_DIR:-results}
 
 run() {
   local name=$1; shift
-  if [[ -f "$runs/$name.done" ]]; then echo "$name: done ($runs/$name/results.json)"; return; fi
+  if [[ -f "$published/$name/results.json" ]]; then echo "$name: done ($published/$name/results.json)"; return; fi
   echo "$name: running (log $runs/$name.log)"
   mkdir -p "$runs/$name"
   "$python" -m experiments."$name" --workdir="$runs/$name" --scale="$scale" --seeds="$seeds" "$@" \
     >> "$runs/$name.log" 2>&1
-  touch "$runs/$name.done"
+  mkdir -p "$published/$name.partial"
+  find "$runs/$name" -maxdepth 1 -type f \( -name 'results.json' -o -name 'results.md' -o -name 'curves.csv' \
+    -o -name '*.png' \) -exec cp {} "$published/$name.partial/" \;
+  rm -rf "$published/$name" && mv "$published/$name.partial" "$published/$name"
+  echo "$name: published $published/$name/"
 }
 share() {  # share FROM TO SWEEP...: copy finished sweeps of experiment FROM into experiment TO
   local from=$1 to=$2; shift 2
@@ -48,5 +56,5 @@ share velocities error_velocities train_20/l1/neural train_20/l1/hybrid
 run error_velocities
 run objects
 run viewpoint
-"$python" -m experiments.findings --workdirs="$(ls -d "$runs"/{data_efficiency,new_pushes,velocities,error_velocities,error_variants,objects} 2>/dev/null | paste -sd,)" \
-  --output="$runs/findings.md"
+"$python" -m experiments.findings --workdirs="$(ls -d "$published"/{data_efficiency,new_pushes,velocities,error_velocities,error_variants,objects} 2>/dev/null | paste -sd,)" \
+  --output="$published/findings.md"
