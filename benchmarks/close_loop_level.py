@@ -5,8 +5,8 @@ Clean data sets of the independent set-up of ``benchmarks/close_loop_power.py`` 
 targets replaced by the plain Lynch model's prediction plus its own residual, the residual's sign flipped per push
 sequence at random: every sequence keeps its residual's size and within-push structure, but no effect can predict
 it on sequences it was not fitted on. The loop's split and forward selection then run as in the loop, at 200
-pushes (a single fit/select split) and at 100 pushes both cross-fitted (the loop's choice below
-``pushjax.loop.splits.CROSS_FIT_BELOW`` select sequences) and with a single split.
+and at 100 pushes, each both with a single fit/select split and cross-fitted (the loop's choice below
+``pushjax.loop.splits.CROSS_FIT_BELOW`` select sequences).
 
 Criterion, fixed before measuring: the selection controls the family-wise error at 0.05, so on this null it should
 select anything in at most 5 % of the draws; a count of draws with a selection whose probability at a true rate of
@@ -29,9 +29,9 @@ from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes
 from pushjax.physics.effects import EFFECT_NAMES
 
-PATHS = {"200 pushes, single split": (200, None), "100 pushes, cross-fitted": (100, None),
-         "100 pushes, single split": (100, 0)}
-"""name -> (push sequences, CROSS_FIT_BELOW override or None for the library's)."""
+PATHS = {"200 pushes, single split": (200, 0), "100 pushes, cross-fitted": (100, 10**6),
+         "100 pushes, single split": (100, 0), "200 pushes, cross-fitted": (200, 10**6)}
+"""name -> (push sequences, CROSS_FIT_BELOW for the path)."""
 LEVEL = 0.05
 
 
@@ -63,10 +63,9 @@ def main():
     start = time.perf_counter()
     clean = [build_examples(iter_pushes(args.data_dir / "clean" / f"seed{seed}"))[0]
              for seed in range(args.recorded_seeds)]
-    library_cross_fit_below = splits.CROSS_FIT_BELOW
     print("| path | draws | anything selected | selections |\n|---|---:|---:|---|")
     for name, (pushes, cross_fit_below) in PATHS.items():
-        splits.CROSS_FIT_BELOW = library_cross_fit_below if cross_fit_below is None else cross_fit_below
+        splits.CROSS_FIT_BELOW = cross_fit_below
         selections = []
         for draw in range(args.draws):
             examples = null_examples(clean[draw % len(clean)], pushes, draw)

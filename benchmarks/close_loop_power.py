@@ -15,7 +15,7 @@ Criteria, fixed before measuring:
   * goal: power >= 90 % at 200 pushes for every case whose added error is >= 20 %; false discoveries <= 5 %.
 
     python benchmarks/close_loop_power.py [--data_dir /tmp/close_loop_power/data] [--seeds 5] [--cases clean,...]
-        [--start_poses fixed|scattered]
+        [--start_poses fixed|scattered] [--first_seed 0]
 
 ``--cases`` analyses only the named cases (e.g. ``--cases clean --seeds 12`` for more clean data sets); the goal
 line then judges only the parts of the goal those cases measure. ``--cross_fit_below N`` overrides
@@ -61,8 +61,8 @@ SIZES = (200, 100)
 POWER_GOAL, FALSE_DISCOVERY_GOAL, ADDED_ERROR_FOR_GOAL = 0.9, 0.05, 0.2
 
 
-def record(data_dir: Path, seeds: int, cases: list[str], start_poses: str) -> None:
-    for seed in range(seeds):
+def record(data_dir: Path, seeds: range, cases: list[str], start_poses: str) -> None:
+    for seed in seeds:
         for name in cases:
             effects = CASES[name]
             record_pushes(data_dir / name / f"seed{seed}", OBJECTS, SURFACES, PUSHES_PER_OBJECT, seed=seed,
@@ -78,16 +78,28 @@ def subsample(examples, pushes: int, seed: int):
     return examples.select(np.isin(examples.sequence, kept))
 
 
+def fitted_values(selection: select.Selection) -> str:
+    """The selected model's values refitted on the pool, e.g. ``friction_ratio.l_scale=0.985``."""
+    if selection.model is None:
+        return ""
+    return " ".join(f"{effect}.{name}={value['value']:.4g}" for effect, values in selection.model.physical.items()
+                    for name, value in values.items())
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--data_dir", type=Path, default=Path("/tmp/close_loop_power/data"))
-    parser.add_argument("--seeds", type=int, default=5)
+    parser.add_argument("--seeds", type=int, default=5, help="data sets per case")
+    parser.add_argument("--first_seed", type=int, default=0,
+                        help="seed of the first data set (e.g. 5 for data sets that chose nothing after seeds 0-4)")
     parser.add_argument("--cases", default=",".join(CASES), help="comma-separated cases to analyse (default: all)")
     parser.add_argument("--cross_fit_below", type=int, default=splits.CROSS_FIT_BELOW,
                         help="select sequences below which the loop cross-fits (the library's value by default)")
     parser.add_argument("--start_poses", choices=START_POSES, default="fixed",
                         help="where the recorded pushes start (fixed: the MIT protocol's one pose)")
     args = parser.parse_args()
+    if args.seeds < 1 or args.first_seed < 0:
+        parser.error(f"--seeds, --first_seed: expected >= 1 and >= 0, got {args.seeds} and {args.first_seed}")
     if args.cross_fit_below < 0:
         parser.error(f"--cross_fit_below: expected >= 0, got {args.cross_fit_below}")
     splits.CROSS_FIT_BELOW = args.cross_fit_below
@@ -97,11 +109,12 @@ def main():
     if "clean" not in cases:
         parser.error("--cases: expected clean among them (the added error of every case is measured against it)")
     start = time.perf_counter()
-    record(args.data_dir, args.seeds, cases, args.start_poses)
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
+    record(args.data_dir, seeds, cases, args.start_poses)
     print(f"recorded (or reused) in {time.perf_counter() - start:.0f} s", flush=True)
     outcomes = collections.defaultdict(list)  # (case, pushes) -> [first selected or None]
     errors = collections.defaultdict(list)  # case -> plain model's score per seed
-    for seed in range(args.seeds):
+    for seed in seeds:
         for name in cases:
             examples = build_examples(iter_pushes(args.data_dir / name / f"seed{seed}"))[0]
             plain = metrics.window_errors(fit_lib.predict([None], examples)[0], examples.target, examples.sequence)
@@ -111,7 +124,7 @@ def main():
                 split = splits.split(subset, len(EFFECT_NAMES), seed=seed)
                 selection = select.select_effects(split, seed=seed)
                 outcomes[name, pushes].append(selection.selected)
-                print(f"{name} seed {seed} {pushes} pushes: {selection.selected} "
+                print(f"{name} seed {seed} {pushes} pushes: {selection.selected} {fitted_values(selection)} "
                       f"({time.perf_counter() - start:.0f} s)", flush=True)
     clean = np.mean(errors["clean"])
     print("\n| case | testbed effect | plain model sum % | added error | pushes | right effect first | "

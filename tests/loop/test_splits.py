@@ -17,7 +17,8 @@ def _sequences(examples, index=None):
     return set(np.unique(examples.sequence if index is None else examples.sequence[index]))
 
 
-def test_single_split_keeps_the_roles_apart_and_is_seeded(examples):
+def test_single_split_keeps_the_roles_apart_and_is_seeded(examples, monkeypatch):
+    monkeypatch.setattr(splits, "CROSS_FIT_BELOW", 30)  # the 120 recorded sequences as if they were many
     split = splits.split(examples, n_candidates=10, seed=3)
     assert not split.cross_fitted
     (fit, select), = split.folds

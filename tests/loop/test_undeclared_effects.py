@@ -33,7 +33,7 @@ def test_report_follows_the_schema(loop_report):
     assert json.loads((workdir / "report.json").read_text()) == report
     assert set(report) == {"n_pushes", "baseline", "diagnosis", "ranking", "selected", "after", "explained",
                            "fallback", "remaining", "uncertainty"}
-    assert report["n_pushes"] == {"fit": 60, "select": 30, "test": 30, "skipped": 0}
+    assert report["n_pushes"] == {"fit": 67, "select": 90, "test": 30, "skipped": 0}  # cross-fitted: every pool push selects
     for key in ("baseline", "after", "fallback"):
         assert set(report[key]) == SUMMARY_KEYS | {"interval"} and set(report[key]["interval"]) == SUMMARY_KEYS
         assert all(low <= report[key][metric] <= high for metric, (low, high) in report[key]["interval"].items())
