@@ -46,10 +46,11 @@ share() {  # share FROM TO SWEEP...: copy finished sweeps of experiment FROM int
 }
 
 run data_efficiency
-share data_efficiency error_variants train/l1/hybrid train/l1/error_error_grad_error_norm
-run error_variants
+# visualize only evaluates data_efficiency's sweeps: run it while they are still in RUNS_DIR.
 share data_efficiency visualize train/l1/neural train/l1/hybrid train/l1/simple train/l1/error
 run visualize --sizes=2500,190000
+share data_efficiency error_variants train/l1/hybrid train/l1/error_error_grad_error_norm
+run error_variants
 run new_pushes
 run velocities
 share velocities error_velocities train_20/l1/neural train_20/l1/hybrid
