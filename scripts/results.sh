@@ -50,12 +50,12 @@ run data_efficiency
 share data_efficiency visualize train/l1/neural train/l1/hybrid train/l1/simple train/l1/error
 run visualize --sizes=2500,190000
 share data_efficiency error_variants train/l1/hybrid train/l1/error_error_grad_error_norm
+run viewpoint
 run error_variants
 run new_pushes
+run objects
 run velocities
 share velocities error_velocities train_20/l1/neural train_20/l1/hybrid
 run error_velocities
-run objects
-run viewpoint
 "$python" -m experiments.findings --workdirs="$(ls -d "$published"/{data_efficiency,new_pushes,velocities,error_velocities,error_variants,objects} 2>/dev/null | paste -sd,)" \
   --output="$published/findings.md"
