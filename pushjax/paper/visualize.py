@@ -31,10 +31,11 @@ def to_push_frame(vectors: np.ndarray, scene_transforms: np.ndarray) -> np.ndarr
 
 def plot(predictions: Mapping[str, Mapping[str, np.ndarray]], examples: Mapping[str, np.ndarray],
          path: str | os.PathLike) -> Path:
-    """A row per variant: predicted object translations (mm) and predicted contacts with normals (mm).
+    """A row per model: predicted object translations (mm) and predicted contacts with normals (mm).
 
     Args:
-      predictions: variant -> `evaluate.predict` outputs on `examples`.
+      predictions: row title (the model: variant, training size, seed) -> `evaluate.predict` outputs on
+        `examples`.
       examples: the ``repeated`` test split, with ``scene_transform``.
       path: the PNG to write.
     """
@@ -43,27 +44,29 @@ def plot(predictions: Mapping[str, Mapping[str, np.ndarray]], examples: Mapping[
     true_contact = to_push_frame(examples["contact"], transforms) * planar.M_TO_MM
     true_normal = to_push_frame(examples["normal"], transforms)
     figure, axes = plt.subplots(len(predictions), 2, figsize=(9, 3.8 * len(predictions)), squeeze=False)
-    for (variant, outputs), (motion_axis, contact_axis) in zip(predictions.items(), axes):
+    for (title, outputs), (motion_axis, contact_axis) in zip(predictions.items(), axes):
         motion = to_push_frame(outputs["motion"][:, :2], transforms) * planar.M_TO_MM
         motion_axis.scatter(motion[:, 0], motion[:, 1], s=8, alpha=0.6, label="predicted")
         motion_axis.scatter(true_motion[:, 0], true_motion[:, 1], marker="*", color="k", s=60, label="true")
-        motion_axis.set_title(f"{variant}: object translation [mm]")
+        motion_axis.set_title(f"{title}\nobject translation [mm]", fontsize="medium")
         motion_axis.set_aspect("equal", "datalim")
-        contact_axis.scatter(true_contact[:, 0], true_contact[:, 1], marker="*", color="k", s=60, label="true")
-        contact_axis.quiver(true_contact[:1, 0], true_contact[:1, 1], true_normal[:1, 0], true_normal[:1, 1],
-                            color="k", width=0.006)
         if "contact" not in outputs:
-            contact_axis.text(0.5, 0.5, f"{variant} predicts no contact", ha="center", va="center",
+            contact_axis.text(0.5, 0.5, "predicts no contact", ha="center", va="center",
                               transform=contact_axis.transAxes)
             contact_axis.set_axis_off()
         else:
+            # Drawn only beside predictions: alone, the true points (equal up to rounding) would be autoscaled
+            # to their rounding noise.
+            contact_axis.scatter(true_contact[:, 0], true_contact[:, 1], marker="*", color="k", s=60, label="true")
+            contact_axis.quiver(true_contact[:1, 0], true_contact[:1, 1], true_normal[:1, 0], true_normal[:1, 1],
+                                color="k", width=0.006)
             contact = to_push_frame(outputs["contact"], transforms) * planar.M_TO_MM
             contact_axis.scatter(contact[:, 0], contact[:, 1], s=8, alpha=0.6, label="predicted")
             if "normal" in outputs:
                 normal = to_push_frame(outputs["normal"], transforms)
                 contact_axis.quiver(contact[:, 0], contact[:, 1], normal[:, 0], normal[:, 1], alpha=0.4,
                                     width=0.003)
-        contact_axis.set_title(f"{variant}: contact point and normal [mm]")
+        contact_axis.set_title(f"{title}\ncontact point and normal [mm]", fontsize="medium")
         contact_axis.set_aspect("equal", "datalim")
         motion_axis.legend(fontsize="small")
     figure.tight_layout()
@@ -73,7 +76,8 @@ def plot(predictions: Mapping[str, Mapping[str, np.ndarray]], examples: Mapping[
 
 
 def plot_outcome(outcome: runner.RunOutcome, workdir: str | os.PathLike) -> Path:
-    """Plots the predictions of each trained variant's first model on the run's (one) test set.
+    """Plots the predictions of each trained variant's model with the most training examples (the first seed
+    among them) on the run's (one) test set.
 
     Writes and returns ``<workdir>/fig8_repeated_pushes.png``.
     """
@@ -82,8 +86,11 @@ def plot_outcome(outcome: runner.RunOutcome, workdir: str | os.PathLike) -> Path
     for sweep in outcome.sweeps:
         result = sweep.result
         for variant in sweep.variants:
-            k = next(k for k, model in enumerate(result.specs) if model.variant in (None, variant))
-            options = None if result.specs[k].variant is None else np.asarray(ERROR_OPTIONS[variant], np.float32)
-            predictions[variant] = evaluate.predict(result.model, result.model_state(k), examples,
+            candidates = [k for k, model in enumerate(result.specs) if model.variant in (None, variant)]
+            k = max(candidates, key=lambda k: len(result.specs[k].train_indices))
+            spec = result.specs[k]
+            options = None if spec.variant is None else np.asarray(ERROR_OPTIONS[variant], np.float32)
+            label = f"{variant} ({len(spec.train_indices)} examples, seed {spec.seed})"
+            predictions[label] = evaluate.predict(result.model, result.model_state(k), examples,
                                                     outcome.spec.train.eval_batch_size, options)
     return plot(predictions, examples, Path(workdir) / "fig8_repeated_pushes.png")
