@@ -8,7 +8,7 @@ frame of the recorded push, so a perfect model would put every point on the true
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import matplotlib
@@ -21,6 +21,7 @@ from pushjax import planar  # noqa: E402
 from pushjax.models import ERROR_OPTIONS  # noqa: E402
 from pushjax.paper import runner  # noqa: E402
 from pushjax.train import evaluate  # noqa: E402
+from pushjax.train.batching import ModelSpec  # noqa: E402
 
 
 
@@ -75,6 +76,13 @@ def plot(predictions: Mapping[str, Mapping[str, np.ndarray]], examples: Mapping[
     return Path(path)
 
 
+def largest_model(specs: Sequence[ModelSpec], variant: str) -> int:
+    """Index of `variant`'s model with the most training examples in a sweep's `specs`, the first among equals
+    (the lowest seed, as sweeps list them)."""
+    candidates = [k for k, spec in enumerate(specs) if spec.variant in (None, variant)]
+    return max(candidates, key=lambda k: len(specs[k].train_indices))
+
+
 def plot_outcome(outcome: runner.RunOutcome, workdir: str | os.PathLike) -> Path:
     """Plots the predictions of each trained variant's model with the most training examples (the first seed
     among them) on the run's (one) test set.
@@ -86,11 +94,10 @@ def plot_outcome(outcome: runner.RunOutcome, workdir: str | os.PathLike) -> Path
     for sweep in outcome.sweeps:
         result = sweep.result
         for variant in sweep.variants:
-            candidates = [k for k, model in enumerate(result.specs) if model.variant in (None, variant)]
-            k = max(candidates, key=lambda k: len(result.specs[k].train_indices))
+            k = largest_model(result.specs, variant)
             spec = result.specs[k]
             options = None if spec.variant is None else np.asarray(ERROR_OPTIONS[variant], np.float32)
             label = f"{variant} ({len(spec.train_indices)} examples, seed {spec.seed})"
             predictions[label] = evaluate.predict(result.model, result.model_state(k), examples,
-                                                    outcome.spec.train.eval_batch_size, options)
+                                                  outcome.spec.train.eval_batch_size, options)
     return plot(predictions, examples, Path(workdir) / "fig8_repeated_pushes.png")
