@@ -64,7 +64,7 @@ from tensorflow_datasets.proto import tf_example_pb2
 from pushjax.data import configs
 from pushjax.data.examples import ALL_FIELDS, make_renderer, sequence_examples
 from pushjax.mit.files import load_push
-from pushjax.sim.dataset import PushJob, record_push
+from pushjax.sim.dataset import PushJob, record_push, recorded_file_problem
 from pushjax.sim.testbed import DEFAULT_PROFILE
 
 DATASET_NAME = "push_effects"
@@ -356,7 +356,8 @@ def keyed_examples(dataset: configs.DatasetConfig, sequence_id: int,
 
 
 def record_missing(job: PushJob, simulate_missing: bool) -> None:
-    """Records the sequence's raw file (MuJoCo testbed) unless it exists.
+    """Records the sequence's raw file (MuJoCo testbed) unless it exists; in pushjax's own cache also records
+    again a file that must be (`pushjax.sim.dataset.recorded_file_problem`: recorded with a flung plate).
 
     Args:
       job: the sequence's recording job.
@@ -368,6 +369,9 @@ def record_missing(job: PushJob, simulate_missing: bool) -> None:
     if not job.path.exists():
         if not simulate_missing:
             raise IncompleteRawDirError(f"raw_dir: {job.path} is missing (a raw folder you give is read-only)")
+        record_push(job)
+    elif simulate_missing and (problem := recorded_file_problem(job)):
+        logging.warning("recording again: %s", problem)
         record_push(job)
 
 

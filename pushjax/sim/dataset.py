@@ -40,7 +40,7 @@ from pushjax.mit.files import PushFileError, PushParams, push_file_name, push_fi
 from pushjax.mit.protocol import MIT_ANGLES, MIT_VELOCITIES, sample_push, side_points
 from pushjax.sim import scene
 from pushjax.sim.effects import Effects
-from pushjax.sim.push import Recording, simulate_push
+from pushjax.sim.push import Recording, implausible_speed, simulate_push
 from pushjax.sim.surfaces import SURFACE_NAMES, get_surface
 from pushjax.sim.testbed import IDEAL, PushConditions, Testbed, draw_conditions
 
@@ -211,6 +211,11 @@ def record_push(job: PushJob) -> Path:
     if attributes is not None and not job.testbed.ideal:
         attributes = {**attributes, "pushjax_testbed_draw": json.dumps(job_conditions(job).draws(), sort_keys=True)}
     recording = simulate_job(job)
+    if recording.line_shift:
+        logging.warning("%s: simulated again with the pusher's line %g mm along the side (a degenerate corner "
+                        "contact flung the plate)", job.path, recording.line_shift * 1000)
+        if attributes is not None:
+            attributes = {**attributes, "pushjax_line_shift_m": recording.line_shift}
     return write_push(job.path, job.params, recording.tip_pose, recording.object_pose, recording.ft_wrench,
                       attributes=attributes)
 
@@ -277,11 +282,8 @@ def record_pushes(
     for job in jobs:
         if not job.path.exists():
             todo.append(job)
-            continue
-        try:
-            read_raw_push(job.path)
-        except PushFileError as error:
-            invalid[job.path] = error
+        elif problem := recorded_file_problem(job):
+            invalid[job.path] = problem
             todo.append(job)
         else:
             skipped.append(job.path)
@@ -304,6 +306,22 @@ def record_pushes(
                     bar.update()
     return RecordSummary(written=written, skipped=skipped,
                          rerecorded=[path for path in written if path in invalid])
+
+
+def recorded_file_problem(job: PushJob) -> str | None:
+    """Why the existing file of a recorded push must be recorded again, or None if it may be kept.
+
+    A file must be recorded again when it does not read as a valid push, or when its object moves implausibly
+    fast (:func:`pushjax.sim.push.implausible_speed`: recorded before that check existed).
+    """
+    try:
+        push = read_raw_push(job.path)
+    except PushFileError as error:
+        return str(error)
+    if (speed := implausible_speed(push.object_pose, job.params)) is not None:
+        return (f"{job.path}: the object moves at {speed * 1000:.0f} mm/s behind a pusher at "
+                f"{job.params.velocity_si * 1000:.0f} mm/s")
+    return None
 
 
 def recording_settings(

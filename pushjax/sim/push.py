@@ -61,6 +61,14 @@ SETTLE_DURATION = 0.3
 MAX_STEP_TRAVEL = 1e-4
 """Largest pusher advance per simulation step in m."""
 MIN_STEPS_PER_SAMPLE = 2
+MAX_SPEED_RATIO = 3.0
+SPEED_ALLOWANCE = 0.01
+"""A recorded push is physically implausible when its object's tracked frame moves, over any
+:data:`SPEED_WINDOW`, faster than ``MAX_SPEED_RATIO`` × the pusher's speed + ``SPEED_ALLOWANCE`` (m/s)."""
+SPEED_WINDOW = 0.1
+"""Time over which the object's speed is measured for the plausibility check, in s."""
+CORNER_SHIFT = 1e-4
+"""How far (m, along the side, towards its middle) the pusher's line moves when a push is simulated again."""
 FIELD_UPDATE_DISTANCE = 5e-4
 """Under a testbed, the position-dependent support coefficients are evaluated again once a support point has
 moved this far (m) from where they were last evaluated (the fields vary over centimetres)."""
@@ -80,6 +88,8 @@ class Recording:
         testbed drops samples).
       ft_wrench: [N, 4] rows [t s, fx N, fy N, torque N·m].
       true_object_pose: [N, 4] the simulated pose of the tracked frame, before the tracking effects.
+      line_shift: how far (m) the pusher's line was moved along the side to avoid a degenerate contact (0 for
+        almost every push; see :meth:`Simulator.run`).
     """
 
     params: PushParams
@@ -87,6 +97,11 @@ class Recording:
     object_pose: np.ndarray
     ft_wrench: np.ndarray
     true_object_pose: np.ndarray
+    line_shift: float = 0.0
+
+
+class ImplausibleMotionError(RuntimeError):
+    """A simulated push moved its object faster than the pusher can (see :func:`implausible_speed`)."""
 
 
 class Simulator:
@@ -154,6 +169,14 @@ class Simulator:
 
         Returns:
           The :class:`Recording`.
+
+        Raises:
+          ImplausibleMotionError: the push moved the object implausibly fast (:func:`implausible_speed`) even
+            with its line shifted. A pusher whose line runs exactly along the face next to the pushed corner
+            (a corner push of a rectangle at 0°) meets a degenerate vertex contact, which MuJoCo's convex
+            collision may resolve along the wrong face and fling the plate centimetres sideways; such a push is
+            simulated again with the pusher's line moved :data:`CORNER_SHIFT` along the side towards its middle
+            (recorded in ``Recording.line_shift``), every other push as requested.
         """
         if params.shape != self.obj.name:
             raise ValueError(f"params: shape {params.shape!r} does not match the simulator's object {self.obj.name!r}")
@@ -170,6 +193,26 @@ class Simulator:
         if noisy and rng is None:
             raise ValueError("rng: required to draw the tracking noise of these effects")
 
+        line_shift = 0.0
+        true_pose, tip_pose, ft_wrench = self._simulate(params, pose, conditions, line_shift)
+        if implausible_speed(true_pose, params) is not None:
+            line_shift = CORNER_SHIFT
+            true_pose, tip_pose, ft_wrench = self._simulate(params, pose, conditions, line_shift)
+            if (speed := implausible_speed(true_pose, params)) is not None:
+                raise ImplausibleMotionError(
+                    f"params: {params}: the object moved at {speed * 1000:.0f} mm/s behind a pusher at "
+                    f"{params.velocity_si * 1000:.0f} mm/s, also with the pusher's line shifted "
+                    f"{CORNER_SHIFT * 1000:g} mm")
+        recorded = _tracked(true_pose, self.effects, rng if noisy else None)
+        if conditions is not None:
+            recorded = conditions.track(recorded)
+        return Recording(params=params, tip_pose=tip_pose, object_pose=recorded, ft_wrench=ft_wrench,
+                         true_object_pose=true_pose, line_shift=line_shift)
+
+    def _simulate(self, params: PushParams, pose: np.ndarray, conditions: PushConditions | None,
+                  line_shift: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """([N, 4] true object pose, [N, 4] tip pose, [N, 4] wrench) of one push (see :meth:`run`), its pusher's
+        line moved ``line_shift`` m along the pushed side towards the side's middle."""
         model, data = self.model, self.data
         steps_per_sample = max(MIN_STEPS_PER_SAMPLE,
                                math.ceil(params.velocity_si * SAMPLE_PERIOD / MAX_STEP_TRAVEL - 1e-9))
@@ -178,7 +221,7 @@ class Simulator:
         nstep = (samples - 1) * steps_per_sample
 
         rotation = planar.rotation_matrix(pose[2])
-        start_local, direction_local = pusher_line(self.obj, params)
+        start_local, direction_local = pusher_line(self.obj, _shifted(self.obj, params, line_shift))
         start = pose[:2] + rotation @ start_local
         direction = rotation @ direction_local
         targets = np.arange(1, nstep + 1) * model.opt.timestep
@@ -222,12 +265,7 @@ class Simulator:
         wrench = np.column_stack([force, moment])
         averaged = np.concatenate([wrench[:1], wrench.reshape(samples - 1, steps_per_sample, 3).mean(axis=1)])
         ft_wrench = np.column_stack([times, averaged])
-
-        recorded = _tracked(true_pose, self.effects, rng if noisy else None)
-        if conditions is not None:
-            recorded = conditions.track(recorded)
-        return Recording(params=params, tip_pose=tip_pose, object_pose=recorded, ft_wrench=ft_wrench,
-                         true_object_pose=true_pose)
+        return true_pose, tip_pose, ft_wrench
 
     def _stepped(self, control: np.ndarray, conditions: PushConditions,
                  steps_per_update: int) -> tuple[np.ndarray, np.ndarray]:
@@ -284,6 +322,33 @@ class Simulator:
         local_x, local_y = self._support_local.T
         speeds = np.hypot(cos * vx + sin * vy - spin * local_y, cos * vy - sin * vx + spin * local_x)
         return (x, y, yaw), speeds
+
+
+def implausible_speed(object_pose: np.ndarray, params: PushParams) -> float | None:
+    """The object's largest speed (m/s, over :data:`SPEED_WINDOW`) if it exceeds what the push can cause, else None.
+
+    Args:
+      object_pose: [N, 4] rows [t s, x m, y m, yaw rad], increasing t (simulated or tracked, with gaps or not).
+      params: the push (its velocity bounds the object's).
+    """
+    times = object_pose[:, 0]
+    later = np.searchsorted(times, times + SPEED_WINDOW)
+    first = np.flatnonzero(later < len(times))
+    if not len(first):
+        return None
+    last = later[first]
+    distance = np.linalg.norm(object_pose[last, 1:3] - object_pose[first, 1:3], axis=1)
+    speed = float((distance / (times[last] - times[first])).max())
+    return speed if speed > MAX_SPEED_RATIO * params.velocity_si + SPEED_ALLOWANCE else None
+
+
+def _shifted(obj: PushObject, params: PushParams, distance: float) -> PushParams:
+    """``params`` with its contact point moved ``distance`` m along the side towards the side's middle."""
+    if distance == 0.0:
+        return params
+    length = float(np.linalg.norm(np.diff(obj.sides[params.side], axis=0), axis=1).sum())
+    step = min(distance / length, abs(0.5 - params.point))
+    return dataclasses.replace(params, point=params.point + math.copysign(step, 0.5 - params.point))
 
 
 def _tracked(true_pose: np.ndarray, effects: Effects, rng: np.random.Generator | None) -> np.ndarray:

@@ -63,6 +63,24 @@ def test_invalid_existing_files_are_rerecorded(tmp_path):
     assert files(tmp_path) == before
 
 
+def test_files_with_a_flung_object_are_rerecorded(tmp_path):
+    """A file recorded before the plausibility check, whose object jumps 3 cm, is recorded again."""
+    arguments = dict(objects=["rect1"], surfaces=["abs"], pushes=2, seed=2, velocities=(20.0,), workers=1,
+                     progress=False)
+    first = dataset.record_pushes(tmp_path, **arguments)
+    before = files(tmp_path)
+    flung, intact = first.written
+    raw = read_raw_push(flung)
+    object_pose = np.array(raw.object_pose)
+    object_pose[len(object_pose) // 2:, 1] += 0.03
+    write_push(flung, raw.params, raw.tip_pose, object_pose, raw.ft_wrench, attributes=raw.attributes)
+    job = next(job for job in dataset.plan_pushes(tmp_path, ["rect1"], ["abs"], 2, 2, (20.0,)) if job.path == flung)
+    assert "behind a pusher at 20 mm/s" in dataset.recorded_file_problem(job)
+    again = dataset.record_pushes(tmp_path, **arguments)
+    assert again.rerecorded == [flung] and again.skipped == [intact]
+    assert files(tmp_path) == before
+
+
 RECORDED = dict(objects=["rect1"], surfaces=["abs"], pushes=1, seed=4, velocities=(20.0,), accelerations=(0.0,),
                 repeats=1, effects=Effects(table_tilt_deg=1.0), declare_effects=True, support="grid")
 

@@ -66,6 +66,34 @@ def test_central_push_translates_with_the_pusher():
     assert np.linalg.norm(recording.true_object_pose[-1, 1:3] - recording.true_object_pose[stop, 1:3]) < 5e-4
 
 
+def test_a_corner_push_along_the_next_face_is_not_flung():
+    """rect3 pushed at the corner of side 1 at 0°: the pusher's line runs along side 0's face, a degenerate vertex
+    contact that MuJoCo resolves along side 0's normal, flinging the plate ~5 cm sideways in 0.3 s; the push is
+    simulated again with its line moved `CORNER_SHIFT` along the side and then moves like a corner push."""
+    p = params(shape="rect3", side=1, point=1.0)
+    recording = simulate_push(p)
+    assert recording.line_shift == push.CORNER_SHIFT
+    assert push.implausible_speed(recording.true_object_pose, p) is None
+    displacement, rotation = motion(recording)
+    direction = protocol.pusher_line("rect3", p)[1]
+    assert displacement @ direction > 0.01 and abs(displacement @ [direction[1], -direction[0]]) < 0.01
+    assert abs(np.degrees(rotation)) > 10.0
+    assert simulate_push(params(shape="rect3", side=1, point=0.9)).line_shift == 0.0
+
+
+def test_implausible_speed_bounds_the_object_by_the_pusher():
+    p = params(velocity=20.0)
+    times = np.arange(0.0, 1.0, 0.004)
+    steady = np.column_stack([times, 0.02 * times, np.zeros_like(times), np.zeros_like(times)])
+    assert push.implausible_speed(steady, p) is None
+    flung = steady.copy()
+    flung[times > 0.5, 1] += 0.03  # 3 cm in one sample
+    gappy = np.delete(flung, np.s_[100:110], axis=0)  # dropped samples: the check goes by time stamps
+    for pose in (flung, gappy):
+        assert push.implausible_speed(pose, p) == pytest.approx(0.32, abs=0.01)
+    assert push.implausible_speed(flung, params(velocity=150.0)) is None
+
+
 def test_fast_push_slides_on_after_the_pusher_stops():
     p = params(velocity=300.0)
     recording = simulate_push(p)
