@@ -43,15 +43,24 @@ def test_fits_several_candidates_at_once_and_recovers_the_parameters(synthetic):
     assert scores[1] < 0.3 * scores[0] and scores[1] < scores[2] < scores[0]
 
 
+CENTRE_SHIFTS = ("cof_offset", "pressure_gradient")
+"""Both move the centre of friction by their ``offset``; pressure_gradient also shrinks l, which friction_ratio
+absorbs, so with friction_ratio either one is the true model (which one wins depends on the split)."""
+
+
 def test_forward_selection_adds_both_effects_and_stops(synthetic):
     split = splits.split(synthetic, len(EFFECT_NAMES), seed=1)
     selection = select.select_effects(split)
-    assert sorted(selection.selected) == ["cof_offset", "friction_ratio"]
+    assert len(selection.selected) == 2 and "friction_ratio" in selection.selected
+    shift = next(effect for effect in selection.selected if effect != "friction_ratio")
+    assert shift in CENTRE_SHIFTS
     assert selection.rounds[-1].accepted is None and len(selection.rounds) == 3
     assert selection.ranking[0].effects[0] in TRUE
     assert selection.final.score < 0.5 * selection.baseline.score
-    # The reported model is refitted on the pool: fit and select sequences, never the test split's.
-    assert set(selection.model.effects) == set(TRUE)
+    # The reported model is refitted on the pool (fit and select sequences, never the test split's) and recovers
+    # the true centre-of-friction offset.
+    assert set(selection.model.effects) == set(selection.selected)
+    np.testing.assert_allclose(selection.model.params[shift]["offset"], TRUE["cof_offset"]["offset"], atol=5e-4)
     assert not set(split.pool.sequence) & set(split.test.sequence)
 
 
