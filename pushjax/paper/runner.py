@@ -17,8 +17,10 @@ standard errors, `pushjax.paper.statistics`). Besides ``rows``:
   ("train": the model's own training examples, or "validation"), "trans_percent", "rot_percent"}, ...]
   (`pushjax.train.curves`; a dataset without a validation split gives the training curve only);
 * ``provenance``: {"commit": the git commit of the code (with ``+changes`` when the tree differed from it),
-  "invocations": [{"commit", "started" (UTC, ISO 8601), "wall_s"}, ...] every call of `run` on this work
-  directory, a resumed one included, "wall_s": their sum}.
+  "invocations": [{"commit", "started" (UTC, ISO 8601), "wall_s", "finished"}, ...] every call of `run` on this
+  work directory, a resumed one included, "wall_s": their sum}. A call is recorded in
+  ``<workdir>/invocations.jsonl`` when it starts and brought up to date after every sweep, so a call that was
+  stopped counts up to its last finished sweep (``"finished": false``).
 
 Each sweep trains in ``<workdir>/<train_split>/l<l_scale>/<variants>`` (checkpoints, ``metrics.csv`` and
 ``curves.csv``), so an interrupted run resumes where it stopped.
@@ -218,15 +220,18 @@ def _git_commit() -> str | None:
     return commit + ("+changes" if changed else "")
 
 
-def _provenance(workdir: Path, started: datetime.datetime, wall_s: float) -> dict:
-    """This call of `run` appended to ``<workdir>/invocations.jsonl``; the provenance of ``results.json``."""
+def _record_sitting(workdir: Path, started: datetime.datetime, wall_s: float, finished: bool) -> dict:
+    """Writes this call of `run` into ``<workdir>/invocations.jsonl`` (replacing its earlier record) and returns
+    the provenance of ``results.json``: every call's record and the sum of their wall times."""
     log = workdir / "invocations.jsonl"
-    commit = _git_commit()
-    with log.open("a") as file:
-        file.write(json.dumps({"commit": commit, "started": started.isoformat(timespec="seconds"),
-                               "wall_s": round(wall_s, 1)}) + "\n")
-    invocations = [json.loads(line) for line in log.read_text().splitlines() if line.strip()]
-    return {"commit": commit, "invocations": invocations,
+    record = {"commit": _git_commit(), "started": started.isoformat(timespec="seconds"),
+              "wall_s": round(wall_s, 1), "finished": finished}
+    invocations = [json.loads(line) for line in log.read_text().splitlines() if line.strip()] if log.exists() else []
+    invocations = [entry for entry in invocations if entry["started"] != record["started"]] + [record]
+    partial = log.with_name(log.name + ".partial")
+    partial.write_text("".join(json.dumps(entry) + "\n" for entry in invocations))
+    partial.replace(log)
+    return {"commit": record["commit"], "invocations": invocations,
             "wall_s": round(sum(entry["wall_s"] for entry in invocations), 1)}
 
 
@@ -253,6 +258,14 @@ def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True)
     """
     workdir = Path(workdir)
     started, clock = datetime.datetime.now(datetime.timezone.utc), time.monotonic()
+    writer = train_lib.distributed.is_writer()
+
+    def record_sitting(finished: bool = False) -> dict:
+        return _record_sitting(workdir, started, time.monotonic() - clock, finished)
+
+    if writer:
+        workdir.mkdir(parents=True, exist_ok=True)
+        record_sitting()
     fields = spec.example_fields()
     splits = load_splits(spec, spec.dataset, progress)
     train_sources = _split_sources(splits, spec.train_splits, spec.dataset)
@@ -280,10 +293,11 @@ def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True)
             sweeps.append(sweep)
             rows += _trained_rows(spec, sweep, scaled_tests)
             curve_rows += _curve_rows(sweep, sweep_dir)
+            if writer:
+                record_sitting()
     results = {"name": spec.name, "config": spec.to_json(), "rows": [finite_or_none(row) for row in rows],
                "curves": [finite_or_none(row) for row in curve_rows]}
-    if train_lib.distributed.is_writer():
-        workdir.mkdir(parents=True, exist_ok=True)
-        results["provenance"] = _provenance(workdir, started, time.monotonic() - clock)
+    if writer:
+        results["provenance"] = record_sitting(finished=True)
         (workdir / "results.json").write_text(json.dumps(results, indent=2))
     return RunOutcome(spec, results, sweeps, test_sets)

@@ -1,5 +1,7 @@
-"""The orchestrator's reports: which dataset a run reads, and what its progress bars name."""
+"""The orchestrator's reports: which dataset a run reads, what its progress bars name, and its record of each sitting."""
 
+import datetime
+import json
 import logging
 
 from pushjax.paper import runner
@@ -44,3 +46,16 @@ def test_every_sweep_of_a_run_is_numbered_in_its_label():
         (3.0, ("hybrid",), "sweep 5/6, l x3: "),
         (3.0, ("error",), "sweep 6/6, l x3: "),
     ]
+
+
+def test_a_stopped_sitting_keeps_its_wall_time_and_the_next_one_adds_to_it(tmp_path):
+    first = datetime.datetime(2026, 1, 1, 10, 0, tzinfo=datetime.timezone.utc)
+    runner._record_sitting(tmp_path, first, 0.0, finished=False)
+    runner._record_sitting(tmp_path, first, 600.0, finished=False)  # after a sweep; then the process is killed
+    second = first + datetime.timedelta(hours=1)
+    provenance = runner._record_sitting(tmp_path, second, 300.0, finished=True)
+    assert [(entry["started"], entry["wall_s"], entry["finished"]) for entry in provenance["invocations"]] == [
+        ("2026-01-01T10:00:00+00:00", 600.0, False), ("2026-01-01T11:00:00+00:00", 300.0, True)]
+    assert provenance["wall_s"] == 900.0
+    lines = (tmp_path / "invocations.jsonl").read_text().splitlines()
+    assert [json.loads(line) for line in lines] == provenance["invocations"]
