@@ -220,11 +220,12 @@ def _git_commit() -> str | None:
     return commit + ("+changes" if changed else "")
 
 
-def _record_sitting(workdir: Path, started: datetime.datetime, wall_s: float, finished: bool) -> dict:
-    """Writes this call of `run` into ``<workdir>/invocations.jsonl`` (replacing its earlier record) and returns
-    the provenance of ``results.json``: every call's record and the sum of their wall times."""
+def _record_sitting(workdir: Path, commit: str | None, started: datetime.datetime, wall_s: float,
+                    finished: bool) -> dict:
+    """Writes this call of `run` (of the code at `commit`) into ``<workdir>/invocations.jsonl``, replacing its
+    earlier record, and returns the provenance of ``results.json``: every call's record and their wall time."""
     log = workdir / "invocations.jsonl"
-    record = {"commit": _git_commit(), "started": started.isoformat(timespec="seconds"),
+    record = {"commit": commit, "started": started.isoformat(timespec="seconds"),
               "wall_s": round(wall_s, 1), "finished": finished}
     invocations = [json.loads(line) for line in log.read_text().splitlines() if line.strip()] if log.exists() else []
     invocations = [entry for entry in invocations if entry["started"] != record["started"]] + [record]
@@ -259,9 +260,10 @@ def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True)
     workdir = Path(workdir)
     started, clock = datetime.datetime.now(datetime.timezone.utc), time.monotonic()
     writer = train_lib.distributed.is_writer()
+    commit = _git_commit() if writer else None
 
     def record_sitting(finished: bool = False) -> dict:
-        return _record_sitting(workdir, started, time.monotonic() - clock, finished)
+        return _record_sitting(workdir, commit, started, time.monotonic() - clock, finished)
 
     if writer:
         workdir.mkdir(parents=True, exist_ok=True)
