@@ -132,24 +132,34 @@ def _curve_means(curves: Sequence[Mapping]) -> dict[tuple, tuple[np.ndarray, np.
             for key, steps in by_step.items()}
 
 
+def _curve_label(train_split: str, size: int, l_scale: float, split: str, several: Mapping[str, bool]) -> str:
+    parts = ([train_split] if several["train_split"] else []) + [f"{size:,} examples"]
+    parts += [f"l x{l_scale:g}"] if several["l_scale"] else []
+    return ", ".join(parts + [split])
+
+
 def curves_figure(curves: Sequence[Mapping], path: str | os.PathLike) -> Path:
     """Learning curves: a panel per model, the score (mean of trans. and rot. % of zero, mean over seeds) on the
     model's own training examples (dashed) and on the validation split (solid) against steps, a line per training
-    size (darker: larger)."""
+    set (training split, size and l scale; darker: later in that order, i.e. larger), each named in the legend
+    by what varies among them."""
     means = _curve_means(curves)
     models = sorted({key[0] for key in means}, key=lambda m: MODEL_ORDER.index(m) if m in MODEL_ORDER else 99)
-    sizes = sorted({key[2] for key in means})
+    several = {"train_split": len({key[1] for key in means}) > 1, "l_scale": len({key[3] for key in means}) > 1}
     columns = min(4, len(models))
     rows = -(-len(models) // columns)
     figure, axes = plt.subplots(rows, columns, figsize=(3.2 * columns, 2.8 * rows), squeeze=False, sharex=True)
     for axis, model in zip(axes.flat, models):
-        for (name, _, size, _, split), (steps, scores) in sorted(means.items(), key=lambda item: str(item[0])):
+        training_sets = sorted({key[1:4] for key in means if key[0] == model},
+                               key=lambda key: (str(key[0]), key[1] or 0, key[2] or 0.0))
+        for key, (steps, scores) in sorted(means.items(), key=lambda item: str(item[0])):
+            name, train_split, size, l_scale, split = key
             if name != model:
                 continue
-            shade = 0.45 + 0.55 * (sizes.index(size) + 1) / len(sizes)
+            shade = 0.45 + 0.55 * (training_sets.index((train_split, size, l_scale)) + 1) / len(training_sets)
             colour = tuple(shade * c + (1 - shade) for c in matplotlib.colors.to_rgb(_colour(model)))
             axis.plot(steps, scores, linestyle="--" if split == "train" else "-", color=colour,
-                      label=f"{size:,} examples, {split}")
+                      label=_curve_label(train_split, size, l_scale, split, several))
         axis.set_title(model, fontsize="medium")
         axis.set_xlabel("training step")
         axis.set_ylabel("score [% of zero]")
