@@ -152,8 +152,8 @@ def curves_figure(curves: Sequence[Mapping], path: str | os.PathLike) -> Path:
     for axis, model in zip(axes.flat, models):
         training_sets = sorted({key[1:4] for key in means if key[0] == model},
                                key=lambda key: (str(key[0]), key[1] or 0, key[2] or 0.0))
-        for key, (steps, scores) in sorted(means.items(), key=lambda item: str(item[0])):
-            name, train_split, size, l_scale, split = key
+        for (name, train_split, size, l_scale, split), (steps, scores) in sorted(
+                means.items(), key=lambda item: str(item[0])):
             if name != model:
                 continue
             shade = 0.45 + 0.55 * (training_sets.index((train_split, size, l_scale)) + 1) / len(training_sets)

@@ -224,6 +224,7 @@ def _record_sitting(workdir: Path, commit: str | None, started: datetime.datetim
                     finished: bool) -> dict:
     """Writes this call of `run` (of the code at `commit`) into ``<workdir>/invocations.jsonl``, replacing its
     earlier record, and returns the provenance of ``results.json``: every call's record and their wall time."""
+    workdir.mkdir(parents=True, exist_ok=True)
     log = workdir / "invocations.jsonl"
     record = {"commit": commit, "started": started.isoformat(timespec="seconds"),
               "wall_s": round(wall_s, 1), "finished": finished}
@@ -262,12 +263,10 @@ def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True)
     writer = train_lib.distributed.is_writer()
     commit = _git_commit() if writer else None
 
-    def record_sitting(finished: bool = False) -> dict:
-        return _record_sitting(workdir, commit, started, time.monotonic() - clock, finished)
+    def record_sitting(finished: bool = False) -> dict | None:
+        return _record_sitting(workdir, commit, started, time.monotonic() - clock, finished) if writer else None
 
-    if writer:
-        workdir.mkdir(parents=True, exist_ok=True)
-        record_sitting()
+    record_sitting()
     fields = spec.example_fields()
     splits = load_splits(spec, spec.dataset, progress)
     train_sources = _split_sources(splits, spec.train_splits, spec.dataset)
@@ -295,8 +294,7 @@ def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True)
             sweeps.append(sweep)
             rows += _trained_rows(spec, sweep, scaled_tests)
             curve_rows += _curve_rows(sweep, sweep_dir)
-            if writer:
-                record_sitting()
+            record_sitting()
     results = {"name": spec.name, "config": spec.to_json(), "rows": [finite_or_none(row) for row in rows],
                "curves": [finite_or_none(row) for row in curve_rows]}
     if writer:
