@@ -59,7 +59,6 @@ def main(argv):
         )
     print(f"wrote results.json and {len(outcome.sweeps)} sweep folder{'s' * (len(outcome.sweeps) != 1)} "
           f"(checkpoints, metrics.csv) to {cli.WORKDIR.value}")
-    return outcome.results
 
 
 if __name__ == "__main__":
