@@ -1,7 +1,7 @@
 r"""Close the loop on measured pushes: residual → the missing effect → refit → test-split error before and after.
 
   python -m experiments.close_loop --data_dir=DIR --workdir=OUT [--horizon=0.5] [--seed=0] \
-      [--heldout_fraction=0.25] [--min_gain=0] [--min_strength=0.1] [--steps=300]
+      [--heldout_fraction=0.25] [--min_gain=0.05] [--min_strength=0.1] [--steps=300]
 
 DIR holds pushes in the raw MIT layout (``<surface>/<object>/motion_surface=...h5``: real MIT files or the
 testbed's, ``python -m experiments.record_pushes``); only the streams and the file-name fields are used.
@@ -28,7 +28,8 @@ _SEED = flags.DEFINE_integer("seed", 0, "Seed of the split, bootstraps and error
 _HELDOUT = flags.DEFINE_float("heldout_fraction", LoopSettings.test_fraction,
                               "Share of push sequences in the untouched test split.")
 _MIN_GAIN = flags.DEFINE_float("min_gain", LoopSettings.min_gain,
-                               "Relative select-split error cut an effect must exceed, on top of being beyond noise.")
+                               "Share of the select-split error above the noise floor that an effect must remove, on "
+                               "top of being beyond noise.")
 _MIN_STRENGTH = flags.DEFINE_float("min_strength", LoopSettings.min_strength,
                                    "Share of the error a variable's correction must remove to count as structure.")
 _STEPS = flags.DEFINE_integer("steps", FitSettings.steps, "Adam steps per effect fit.", lower_bound=1)
@@ -44,7 +45,8 @@ def main(argv):
         raise app.UsageError(f"--heldout_fraction: expected a fraction in (0, {1 - LoopSettings.select_fraction:g}), "
                              f"got {_HELDOUT.value}")
     if not 0 <= _MIN_GAIN.value < 1:
-        raise app.UsageError(f"--min_gain: expected a relative error cut in [0, 1), got {_MIN_GAIN.value}")
+        raise app.UsageError(f"--min_gain: expected a share of the error above the noise floor in [0, 1), got "
+                             f"{_MIN_GAIN.value}")
     if not 0 <= _MIN_STRENGTH.value <= 1:
         raise app.UsageError(f"--min_strength: expected a share of the error in [0, 1], got {_MIN_STRENGTH.value}")
     settings = LoopSettings(horizon=_HORIZON.value, test_fraction=_HELDOUT.value, min_gain=_MIN_GAIN.value,
@@ -57,8 +59,8 @@ def main(argv):
         if message.startswith("data_dir"):
             message = "--" + message
         raise app.UsageError(message) from None
-    summary = {key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "explained", "fallback",
-                                            "remaining")}
+    summary = {key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "noise_floor", "explained",
+                                            "fallback", "remaining")}
     print(json.dumps(summary, indent=2))
     print(f"wrote report.json, details.json, report.md and figures/ to {_WORKDIR.value}")
 

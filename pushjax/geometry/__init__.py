@@ -10,4 +10,5 @@ from pushjax.geometry.objects import (
     footprint_grid,
     get_object,
     limit_surface_ratio,
+    support_cells,
 )

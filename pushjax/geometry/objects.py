@@ -205,6 +205,42 @@ def footprint_grid(obj: PushObject, resolution: int) -> np.ndarray:
     return grid[inside]
 
 
+SUPPORT_RESOLUTION = 8
+"""Cells along the longer footprint side in :func:`support_cells` (24 to 52 cells for the MIT objects)."""
+PATCH_RADIUS_OVER_CELL = 0.3826
+"""Mean distance of a square cell's points from its centre over the cell's side: a support point with a patch of
+this radius (times the side) dissipates what the cell does when the object turns about the point."""
+
+
+def support_cells(obj: PushObject, resolution: int = SUPPORT_RESOLUTION,
+                  subsamples: int = 8) -> tuple[np.ndarray, np.ndarray, float]:
+    """The footprint as support cells for the exact limit surface (:mod:`pushjax.physics.limit_surface`).
+
+    Args:
+      obj: the object.
+      resolution: cells along the longer side of the footprint's bounding box.
+      subsamples: points per cell side with which the part of a cell inside the footprint is measured.
+
+    Returns:
+      (points [K, 2] centroids of the cells' parts inside the footprint, relative to their area centroid (the
+      uniform plate's centre of mass), object axes, m; weights [K] those parts' areas over the footprint's (summing to about 1); the patch
+      radius, m, :data:`PATCH_RADIUS_OVER_CELL` times the cell side).
+    """
+    if resolution < 2 or subsamples < 1:
+        raise ValueError(f"resolution, subsamples: expected >= 2 and >= 1, got {resolution}, {subsamples}")
+    fine = footprint_grid(obj, resolution * subsamples)
+    lo = obj.outline.min(axis=0)
+    cell = (obj.outline.max(axis=0) - lo).max() / resolution
+    index = np.floor((fine - lo) / cell).astype(int)
+    keys, inverse = np.unique(index[:, 0] * (resolution + 1) + index[:, 1], return_inverse=True)
+    counts = np.bincount(inverse, minlength=len(keys)).astype(np.float64)
+    centroids = np.stack([np.bincount(inverse, fine[:, axis], len(keys)) for axis in (0, 1)], axis=1) / counts[:, None]
+    weights = counts / counts.sum()
+    # Centred on their own area centroid, which the sampling puts up to a few tenths of a cell off the plate's: a
+    # uniform pressure then has its centre exactly at the centre of mass, as in Lynch's model.
+    return centroids - weights @ centroids, weights, PATCH_RADIUS_OVER_CELL * cell
+
+
 def _polygon_object(name: str, vertices) -> PushObject:
     vertices = np.asarray(vertices, dtype=np.float64)
     if shapely.Polygon(vertices).exterior.is_ccw is False:

@@ -30,7 +30,7 @@ from jax.flatten_util import ravel_pytree
 
 from pushjax.loop.windows import Examples
 from pushjax.physics import effects as effects_lib
-from pushjax.physics.effects import EFFECT_NAMES, EFFECTS, PushInputs
+from pushjax.physics.effects import EFFECT_NAMES, EFFECTS, ELLIPSOID_EFFECTS, PushInputs
 
 PAD_MULTIPLE = 1024
 """Example counts are padded (with zero weight) to a multiple of this, so programs compile once per size."""
@@ -90,8 +90,7 @@ def to_batch(examples: Examples) -> Batch:
     def pad(values):
         return jnp.asarray(np.asarray(values)[index], jnp.float32)
 
-    inputs = PushInputs(**{field.name: pad(getattr(examples.inputs, field.name))
-                           for field in dataclasses.fields(PushInputs)})
+    inputs = jax.tree.map(pad, examples.inputs)
     weight = np.zeros(size, np.float32)
     weight[:count] = 1.0
     return Batch(inputs=inputs, target=pad(examples.target), weight=jnp.asarray(weight), count=count)
@@ -104,43 +103,56 @@ def zero_scales(examples: Examples) -> tuple[float, float]:
             max(float(np.mean(np.abs(target[:, 2]))), 1e-6))
 
 
-_FULL_MODEL = effects_lib.compose(EFFECT_NAMES)
+def _family_names(exact: bool) -> tuple[str, ...]:
+    """The effects of one compiled full model: the ellipsoidal library, or every effect that composes with the exact
+    limit surface (``limit_surface`` itself included)."""
+    if not exact:
+        return ELLIPSOID_EFFECTS
+    return tuple(name for name in EFFECT_NAMES if name not in EFFECTS["limit_surface"].excludes)
+
+
+_FULL_MODELS = {exact: effects_lib.compose(_family_names(exact)) for exact in (False, True)}
 _TYPICAL = {name: {key: float(value) for key, value in EFFECTS[name].typical.items()} for name in EFFECT_NAMES}
 
 
-def _params_from_scaled(scaled, mask):
+def is_exact(candidate: Sequence[str]) -> bool:
+    """Whether a candidate effect set uses the exact limit surface (and so the second compiled family)."""
+    return "limit_surface" in candidate
+
+
+def _params_from_scaled(scaled, mask, exact):
     """SI parameters of one candidate from its scaled variables and [E] effect mask."""
     return {name: {key: mask[i] * value * _TYPICAL[name][key] for key, value in scaled[name].items()}
-            for i, name in enumerate(EFFECT_NAMES)}
+            for i, name in enumerate(_family_names(exact))}
 
 
 def _scaled_from_params(params):
-    return {name: {key: value / _TYPICAL[name][key] for key, value in params[name].items()} for name in EFFECT_NAMES}
+    return {name: {key: value / _TYPICAL[name][key] for key, value in values.items()} for name, values in params.items()}
 
 
-def _window_loss(params, inputs, target, scales, floors):
-    prediction = _FULL_MODEL(params, inputs)
+def _window_loss(params, inputs, target, scales, floors, exact):
+    prediction = _FULL_MODELS[exact](params, inputs)
     translation = jnp.sum((prediction[:, :2] - target[:, :2]) ** 2, axis=-1) / scales[0] ** 2
     rotation = (prediction[:, 2] - target[:, 2]) ** 2 / scales[1] ** 2
     return jnp.sqrt(translation + floors[0] ** 2) + jnp.sqrt(rotation + floors[1] ** 2)
 
 
-def _candidate_loss(scaled, mask, batch_inputs, target, weight, scales, floors):
-    losses = _window_loss(_params_from_scaled(scaled, mask), batch_inputs, target, scales, floors)
+def _candidate_loss(scaled, mask, batch_inputs, target, weight, scales, floors, exact):
+    losses = _window_loss(_params_from_scaled(scaled, mask, exact), batch_inputs, target, scales, floors, exact)
     return jnp.sum(weight * losses) / jnp.sum(weight)
 
 
-@functools.partial(jax.jit, static_argnames=("steps", "learning_rate"))
-def _optimise(scaled, masks, inputs, target, weight, scales, floors, steps, learning_rate):
+@functools.partial(jax.jit, static_argnames=("steps", "learning_rate", "exact"))
+def _optimise(scaled, masks, inputs, target, weight, scales, floors, steps, learning_rate, exact):
     optimiser = optax.adam(optax.cosine_decay_schedule(learning_rate, steps))
 
     def total(scaled):
-        losses = jax.vmap(_candidate_loss, in_axes=(0, 0, None, None, None, None, None))(
-            scaled, masks, inputs, target, weight, scales, floors)
+        losses = jax.vmap(_candidate_loss, in_axes=(0, 0, None, None, None, None, None, None))(
+            scaled, masks, inputs, target, weight, scales, floors, exact)
         return jnp.sum(losses), losses
 
     def project(scaled):
-        params = jax.vmap(_params_from_scaled)(scaled, masks)
+        params = jax.vmap(lambda s, m: _params_from_scaled(s, m, exact))(scaled, masks)
         return _scaled_from_params(effects_lib.project_params(params))
 
     def step(carry, _):
@@ -154,31 +166,31 @@ def _optimise(scaled, masks, inputs, target, weight, scales, floors, steps, lear
     return scaled, total(scaled)[1]
 
 
-@jax.jit
-def _residual_jacobian(scaled, mask, inputs, target, scales):
+@functools.partial(jax.jit, static_argnames="exact")
+def _residual_jacobian(scaled, mask, inputs, target, scales, exact):
     """Scaled residuals [N, 3] of one candidate and their Jacobian [N, 3, P] by the flat variables."""
     flat, unravel = ravel_pytree(scaled)
 
     def residuals(flat):
-        prediction = _FULL_MODEL(_params_from_scaled(unravel(flat), mask), inputs)
+        prediction = _FULL_MODELS[exact](_params_from_scaled(unravel(flat), mask, exact), inputs)
         return (prediction - target) / jnp.stack([scales[0], scales[0], scales[1]])
 
     return residuals(flat), jax.jacfwd(residuals)(flat)
 
 
-@jax.jit
-def _physical_jacobian(scaled, mask):
+@functools.partial(jax.jit, static_argnames="exact")
+def _physical_jacobian(scaled, mask, exact):
     flat, unravel = ravel_pytree(scaled)
 
     def values(flat):
-        params = _params_from_scaled(unravel(flat), mask)
+        params = _params_from_scaled(unravel(flat), mask, exact)
         return ravel_pytree(effects_lib.physical_params(params))[0]
 
     return values(flat), jax.jacfwd(values)(flat)
 
 
-def _masks(candidates: Sequence[Sequence[str]]) -> np.ndarray:
-    return np.array([[name in candidate for name in EFFECT_NAMES] for candidate in candidates], np.float32)
+def _masks(candidates: Sequence[Sequence[str]], exact: bool) -> np.ndarray:
+    return np.array([[name in candidate for name in _family_names(exact)] for candidate in candidates], np.float32)
 
 
 def _stack(trees):
@@ -206,39 +218,48 @@ def fit_effects(
     candidates = [tuple(effects_lib.init_params(candidate)) for candidate in candidates]  # checked, in library order
     if not candidates:
         return []
+    initial = list(initial or []) + [None] * (len(candidates) - len(initial or []))
     batch = to_batch(examples)
     scales = jnp.asarray(zero_scales(examples), jnp.float32)
     floors = jnp.asarray([1e-3 * settings.translation_floor_mm / scales[0],
                           math.radians(settings.rotation_floor_deg) / scales[1]], jnp.float32)
-    # Pad the candidate axis to the library size: one compiled program for every round of selection.
-    slots = max(len(EFFECT_NAMES), len(candidates))
-    masks = _masks(list(candidates) + [()] * (slots - len(candidates)))
-    initial = list(initial or []) + [None] * (slots - len(initial or []))
-    starts = []
-    for start in initial:
-        params = effects_lib.init_params()
-        for name, values in (start or {}).items():
-            params[name] = {key: jnp.asarray(value, jnp.float32) for key, value in values.items()}
-        starts.append(_scaled_from_params(params))
-    scaled, losses = _optimise(_stack(starts), jnp.asarray(masks), batch.inputs, batch.target, batch.weight,
-                               scales, floors, steps=settings.steps, learning_rate=settings.learning_rate)
     sequence = np.concatenate([examples.sequence, np.full(len(batch.weight) - batch.count, -1)])
-    results = []
-    for k, candidate in enumerate(candidates):
-        one = jax.tree.map(lambda leaf: leaf[k], scaled)
-        params = jax.device_get(_params_from_scaled(one, jnp.asarray(masks[k])))
-        results.append(FitResult(
-            effects=candidate,
-            params={name: {key: np.asarray(value) for key, value in params[name].items()} for name in candidate},
-            physical=_physical_with_std(one, masks[k], batch, scales, floors, sequence, candidate),
-            loss=float(losses[k]),
-        ))
+    results: list[FitResult | None] = [None] * len(candidates)
+    for exact in (False, True):
+        members = [k for k, candidate in enumerate(candidates) if is_exact(candidate) == exact]
+        if not members:
+            continue
+        names = _family_names(exact)
+        # The candidate axis is padded to the library size: one compiled program for every round of selection.
+        slots = max(len(names), len(members))
+        group = [candidates[k] for k in members]
+        masks = _masks(group + [()] * (slots - len(group)), exact)
+        starts = []
+        for start in [initial[k] for k in members] + [None] * (slots - len(members)):
+            params = effects_lib.init_params(names)
+            for name, values in (start or {}).items():
+                if name in params:
+                    params[name] = {key: jnp.asarray(value, jnp.float32) for key, value in values.items()}
+            starts.append(_scaled_from_params(params))
+        scaled, losses = _optimise(_stack(starts), jnp.asarray(masks), batch.inputs, batch.target, batch.weight,
+                                   scales, floors, steps=settings.steps, learning_rate=settings.learning_rate,
+                                   exact=exact)
+        for slot, k in enumerate(members):
+            one = jax.tree.map(lambda leaf: leaf[slot], scaled)
+            params = jax.device_get(_params_from_scaled(one, jnp.asarray(masks[slot]), exact))
+            results[k] = FitResult(
+                effects=candidates[k],
+                params={name: {key: np.asarray(value) for key, value in params[name].items()}
+                        for name in candidates[k]},
+                physical=_physical_with_std(one, masks[slot], batch, scales, floors, sequence, candidates[k], exact),
+                loss=float(losses[slot]),
+            )
     return results
 
 
-def _physical_with_std(scaled, mask, batch, scales, floors, sequence, candidate):
+def _physical_with_std(scaled, mask, batch, scales, floors, sequence, candidate, exact):
     residual, jacobian = jax.device_get(_residual_jacobian(scaled, jnp.asarray(mask), batch.inputs, batch.target,
-                                                           scales))
+                                                           scales, exact))
     floors = np.asarray(floors, np.float64)
     used = sequence >= 0
     residual, jacobian, sequence = residual[used].astype(np.float64), jacobian[used].astype(np.float64), sequence[used]
@@ -265,10 +286,10 @@ def _physical_with_std(scaled, mask, batch, scales, floors, sequence, candidate)
     inverse = eigenvectors @ np.diag(1.0 / np.maximum(np.abs(eigenvalues), floor)) @ eigenvectors.T
     meat = per_sequence.T @ per_sequence * len(ids) / max(len(ids) - 1, 1)
     covariance = inverse @ meat @ inverse
-    values, value_jacobian = jax.device_get(_physical_jacobian(scaled, jnp.asarray(mask)))
+    values, value_jacobian = jax.device_get(_physical_jacobian(scaled, jnp.asarray(mask), exact))
     value_jacobian = np.asarray(value_jacobian, np.float64)[:, active]
     std = np.sqrt(np.maximum(np.einsum("qp,pr,qr->q", value_jacobian, covariance, value_jacobian), 0.0))
-    physical = effects_lib.physical_params(jax.device_get(_params_from_scaled(scaled, jnp.asarray(mask))))
+    physical = effects_lib.physical_params(jax.device_get(_params_from_scaled(scaled, jnp.asarray(mask), exact)))
     _, unravel = ravel_pytree(jax.tree.map(np.asarray, physical))
     value_tree, std_tree = unravel(np.asarray(values)), unravel(std)
     # A value whose derivative does not exist at the optimum (e.g. an axis at zero anisotropy) has no std.
@@ -277,21 +298,29 @@ def _physical_with_std(scaled, mask, batch, scales, floors, sequence, candidate)
                    for key in value_tree[name]} for name in candidate}
 
 
-@jax.jit
-def _predict_many(scaled, masks, inputs):
-    return jax.vmap(lambda s, m: _FULL_MODEL(_params_from_scaled(s, m), inputs))(scaled, masks)
+@functools.partial(jax.jit, static_argnames="exact")
+def _predict_many(scaled, masks, inputs, exact):
+    return jax.vmap(lambda s, m: _FULL_MODELS[exact](_params_from_scaled(s, m, exact), inputs))(scaled, masks)
 
 
 def predict(results: Sequence[FitResult | None], examples: Examples) -> np.ndarray:
     """[M, N, 3] predictions on ``examples`` of fitted models (None: the plain Lynch model)."""
     batch = to_batch(examples)
-    slots = max(len(EFFECT_NAMES), len(results))
-    params = []
-    for result in list(results) + [None] * (slots - len(results)):
-        full = effects_lib.init_params()
-        for name, values in (result.params if result is not None else {}).items():
-            full[name] = {key: jnp.asarray(value, jnp.float32) for key, value in values.items()}
-        params.append(_scaled_from_params(full))
-    masks = jnp.ones((slots, len(EFFECT_NAMES)), jnp.float32)
-    prediction = _predict_many(_stack(params), masks, batch.inputs)
-    return np.asarray(prediction, np.float64)[:len(results), :batch.count]
+    prediction = np.zeros((len(results), batch.count, 3))
+    for exact in (False, True):
+        members = [k for k, result in enumerate(results)
+                   if (result is not None and is_exact(result.effects)) == exact]
+        if not members:
+            continue
+        names = _family_names(exact)
+        slots = max(len(names), len(members))
+        params = []
+        for k in members + [None] * (slots - len(members)):
+            full = effects_lib.init_params(names)
+            for name, values in (results[k].params if k is not None and results[k] is not None else {}).items():
+                full[name] = {key: jnp.asarray(value, jnp.float32) for key, value in values.items()}
+            params.append(_scaled_from_params(full))
+        masks = jnp.ones((slots, len(names)), jnp.float32)
+        many = _predict_many(_stack(params), masks, batch.inputs, exact)
+        prediction[members] = np.asarray(many, np.float64)[:len(members), :batch.count]
+    return prediction

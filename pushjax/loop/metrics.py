@@ -153,6 +153,98 @@ def smallest_pvalue(n_sequences: int, n_flips: int = 10000) -> float:
     return 2.0 ** -n_sequences if n_sequences <= EXACT_FLIPS_UP_TO else 1 / (1 + n_flips)
 
 
+def holm(p_values: np.ndarray, alpha: float) -> tuple[np.ndarray, np.ndarray]:
+    """Holm's step-down test of M hypotheses at the family-wise level ``alpha``.
+
+    Returns:
+      ([M] bool, whether each is rejected; [M] the level each p-value was compared with, ``alpha / (M - rank)``,
+      the rank counted from the smallest p-value; a hypothesis after the first non-rejection keeps its level but
+      is not rejected).
+    """
+    p_values = np.asarray(p_values, np.float64)
+    order = np.argsort(p_values, kind="stable")
+    levels = np.empty(len(p_values))
+    levels[order] = alpha / (len(p_values) - np.arange(len(p_values)))
+    passed = np.cumprod(p_values[order] <= levels[order]).astype(bool)
+    rejected = np.empty(len(p_values), bool)
+    rejected[order] = passed
+    return rejected, levels
+
+
+@dataclasses.dataclass(frozen=True)
+class NoiseFloor:
+    """The error the best possible model would still have on a set of windows.
+
+    Attributes:
+      trans_pct, rot_pct: translation and rotation error in % of the ``zero`` baseline's on the same windows.
+      interval: {"trans_pct", "rot_pct": [low, high]} 95 % sequence-bootstrap interval.
+      source: ``"repeats"`` (the spread of repeated pushes: tracking noise and everything that differs between
+        repetitions) or ``"tracking"`` (only the measurement noise seen in the pose streams, a lower bound, where no
+        push is repeated).
+      n_windows: windows it is estimated on.
+    """
+
+    trans_pct: float
+    rot_pct: float
+    interval: dict[str, list[float]]
+    source: str
+    n_windows: int
+
+    @property
+    def score(self) -> float:
+        return self.trans_pct + self.rot_pct
+
+    def as_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+MIN_REPEATED_WINDOWS = 20
+"""Fewest windows with repetitions that :func:`noise_floor` estimates the floor from; fewer use tracking noise."""
+
+
+def noise_floor(target: np.ndarray, sequence: np.ndarray, push: np.ndarray, window: np.ndarray,
+                tracking_noise: np.ndarray, n_bootstrap: int = 1000, seed: int = 0) -> NoiseFloor:
+    """The error of an oracle that predicts each window's expected motion, estimated from the data.
+
+    With repeated pushes (windows of the same index in several pushes of one sequence), the oracle's error on a
+    window is its distance from the other repetitions' mean, times ``sqrt((n - 1) / n)`` (which turns the spread
+    about a leave-one-out mean into that about the true mean, for Gaussian spread). Without, the targets are
+    differences of two poses each with white tracking noise ``s`` ([N, 3] ``tracking_noise``): the oracle's mean
+    error is ``s sqrt(pi)`` in translation (Rayleigh with ``sqrt(2) s`` per axis) and ``2 s / sqrt(pi)`` in rotation.
+
+    Args:
+      target: [N, 3] measured motions (m, m, rad).
+      sequence, push, window: [N] the windows' push sequence, push and index in the push.
+      tracking_noise: [N, 3] measurement noise (m, m, rad).
+      n_bootstrap, seed: the sequence bootstrap of the interval.
+    """
+    target = np.asarray(target, np.float64)
+    groups = np.unique(np.stack([sequence, window], axis=1), axis=0, return_inverse=True)[1].reshape(-1)
+    sizes = np.bincount(groups)[groups]
+    repeated = sizes > 1
+    if repeated.sum() >= MIN_REPEATED_WINDOWS:
+        source, keep = "repeats", repeated
+        totals = np.stack([np.bincount(groups, target[:, axis]) for axis in range(3)], axis=1)[groups]
+        n = sizes[:, None].astype(np.float64)
+        others = (totals - target) / np.maximum(n - 1, 1)
+        deviation = (target - others) * np.sqrt(np.maximum(n - 1, 1) / n)
+        trans = np.linalg.norm(deviation[:, :2], axis=1)
+        rot = np.abs(deviation[:, 2])
+    else:
+        source, keep = "tracking", np.ones(len(target), bool)
+        noise = np.asarray(tracking_noise, np.float64)
+        trans = np.sqrt(np.pi) * np.sqrt(0.5 * (noise[:, 0] ** 2 + noise[:, 1] ** 2))
+        rot = 2.0 * noise[:, 2] / np.sqrt(np.pi)
+    oracle = WindowErrors(translation_mm=1e3 * trans[keep], rotation_deg=np.degrees(rot[keep]),
+                          zero_translation_mm=1e3 * np.linalg.norm(target[keep, :2], axis=1),
+                          zero_rotation_deg=np.degrees(np.abs(target[keep, 2])), sequence=np.asarray(sequence)[keep])
+    summary = summarize(oracle)
+    interval = bootstrap_interval(oracle, n_bootstrap, seed)
+    return NoiseFloor(trans_pct=summary["trans_pct"], rot_pct=summary["rot_pct"],
+                      interval={key: interval[key] for key in ("trans_pct", "rot_pct")}, source=source,
+                      n_windows=int(keep.sum()))
+
+
 def predictive_scores(mean: np.ndarray, std: np.ndarray, target: np.ndarray, yaw: np.ndarray) -> dict[str, float]:
     """Scores of Gaussian predictive distributions on [N, 3] targets (dx m, dy m, dtheta rad).
 

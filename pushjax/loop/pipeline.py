@@ -39,8 +39,8 @@ class LoopSettings:
       select_fraction: share of push sequences in the select split (when not cross-fitted).
       pusher_friction: nominal pusher-object friction coefficient.
       effects: candidate library effects.
-      min_gain: relative selection-error cut an effect's point estimate must exceed to be selected (on top
-        of being beyond noise).
+      min_gain: share of the current selection error above the noise floor that an effect must remove to be
+        selected (on top of being beyond noise).
       min_strength: share of the error a variable's correction must remove to count as structure.
       alpha: family-wise error level of the selection, fallback and diagnosis decisions.
       n_bootstrap: bootstrap resamplings of push sequences.
@@ -97,11 +97,6 @@ class Decision:
     def remaining(self) -> list[diagnose_lib.Dependence]:
         """The variables the selected model's residual still depends on beyond noise."""
         return [d for d in self.diagnosis_after if d.beyond_noise]
-
-    @property
-    def explained(self) -> bool:
-        """Nothing (no further effect, not the fallback, no variable) improves on the selected model beyond noise."""
-        return not self.fallback_helps and not self.remaining
 
 
 def decide(examples: Examples, settings: LoopSettings = LoopSettings(), seed: int = 0,
@@ -221,6 +216,11 @@ def close_loop(
 
         yaw = np.asarray(test.inputs.object_yaw, np.float64)
         noise = np.broadcast_to(decision.noise, model_test.shape)
+        floor = metrics.noise_floor(test.target, test.sequence, test.push, test.window, test.tracking_noise,
+                                    settings.n_bootstrap, seed)
+        after = measured(model_test)
+        above = {key: after[key] - getattr(floor, key) for key in ("trans_pct", "rot_pct")}
+        explained = all(after[key] <= floor.interval[key][1] for key in above)
         stages.update()
 
         stage("writing the report")
@@ -231,10 +231,12 @@ def close_loop(
             "ranking": [{"effect": c.effects[0], "params": c.fits[0].physical[c.effects[0]],
                          "select": report_lib.as_summary(c.summary)} for c in selection.ranking],
             "selected": selection.selected,
-            "after": measured(model_test),
-            "explained": decision.explained,
+            "after": after,
+            "noise_floor": floor.as_dict(),
+            "explained": explained,
             "fallback": measured(fallback_mean),
-            "remaining": [{"variable": d.variable, "strength": d.strength} for d in decision.remaining],
+            "remaining": {"above_floor": above,
+                          "variables": [{"variable": d.variable, "strength": d.strength} for d in decision.remaining]},
             "uncertainty": {
                 "selected": {**metrics.predictive_scores(model_test, noise, test.target, yaw),
                              "noise": {"x_mm": 1e3 * float(decision.noise[0]), "y_mm": 1e3 * float(decision.noise[1]),
@@ -256,8 +258,11 @@ def close_loop(
                         **build.skipped},
             "diagnosis_before": _dependences(decision.diagnosis_before),
             "diagnosis_after": _dependences(decision.diagnosis_after),
+            "select_noise_floor": selection.noise_floor.as_dict(),
             "rounds": [{"gains": dict(zip(r.additions, r.gains)), "p_values": dict(zip(r.additions, r.p_values)),
-                        "level": r.level, "accepted": r.accepted} for r in selection.rounds],
+                        "levels": dict(zip(r.additions, r.levels)),
+                        "beyond_noise": dict(zip(r.additions, r.beyond_noise)), "floor": r.floor,
+                        "accepted": r.accepted} for r in selection.rounds],
             "fallback_select": {"gain": decision.fallback_gain, "p_value": decision.fallback_p_value,
                                 "beyond_noise": decision.fallback_helps},
             "selected_params": model.physical if model is not None else {},

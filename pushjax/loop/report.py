@@ -146,16 +146,19 @@ def markdown(report: dict, details: dict) -> str:
     lines += [f"| {entry['effect']} | {_params_text(entry['params'])} | "
               f"{entry['select']['trans_pct'] + entry['select']['rot_pct']:.1f} | {entry['select']['trans_mm']:.3f} | "
               f"{entry['select']['rot_deg']:.3f} |" for entry in report["ranking"]]
+    select_floor = details["select_noise_floor"]
     lines += ["", "## Forward selection", "",
-              f"An effect is added when its gain on the select split is beyond noise: the one-sided sign-flip test "
-              f"over select push sequences gives a p-value of at most {details['alpha']:g} over the number of "
-              f"candidates of the round (family-wise level {details['alpha']:g}), and its relative gain exceeds "
-              f"{details['min_gain']:g}.", ""]
+              f"Every candidate of a round is tested: its gain on the select split must be beyond noise (one-sided "
+              f"sign-flip tests over select push sequences, Holm's procedure over the round's candidates at the "
+              f"family-wise level {details['alpha']:g}) and remove more than {details['min_gain']:g} of the current "
+              f"error above the select split's noise floor ({select_floor['trans_pct'] + select_floor['rot_pct']:.1f} "
+              f"% from {select_floor['source']}); of those that pass, the largest gain is added.", ""]
     for k, round_ in enumerate(details["rounds"], 1):
-        best = max(round_["gains"], key=round_["gains"].get)
-        lines.append(f"{k}. best addition `{best}`: gain {round_['gains'][best]:+.3f}, p = "
-                     f"{round_['p_values'][best]:.2g} (level {round_['level']:.2g}) → "
-                     f"{'added' if round_['accepted'] else 'stop'}")
+        best = round_["accepted"] or max(round_["gains"], key=round_["gains"].get)
+        lines.append(f"{k}. {'added' if round_['accepted'] else 'stop; largest gain'} `{best}`: gain "
+                     f"{round_['gains'][best]:+.3f}, p = {round_['p_values'][best]:.2g} (Holm level "
+                     f"{round_['levels'][best]:.2g}); candidates beyond noise: "
+                     f"{', '.join(name for name, passed in round_['beyond_noise'].items() if passed) or 'none'}")
     if report["selected"]:
         lines += ["", "Fitted parameters of the selected model (every pool push):", ""]
         lines += [f"- {name}: {_params_text(params)}" for name, params in details["selected_params"].items()]
@@ -168,14 +171,21 @@ def markdown(report: dict, details: dict) -> str:
               f"![strengths]({FIGURE_DIR}/diagnosis.png)", "",
               f"Learned error term on the select split: gain {fallback['gain']:+.3f} over the selected model, "
               f"p = {fallback['p_value']:.2g}.", ""]
+    floor, above = report["noise_floor"], report["remaining"]["above_floor"]
+    lines.append(
+        f"Noise floor of the test split (from {floor['source']}, {floor['n_windows']} windows): translation "
+        f"{floor['trans_pct']:.1f} % ({floor['interval']['trans_pct'][0]:.1f}–{floor['interval']['trans_pct'][1]:.1f}),"
+        f" rotation {floor['rot_pct']:.1f} % ({floor['interval']['rot_pct'][0]:.1f}–"
+        f"{floor['interval']['rot_pct'][1]:.1f}).")
+    lines.append("")
     if report["explained"]:
-        lines.append("**Explained:** neither a further effect, nor the learned error term, nor a correction by any "
-                     "variable lowers the error of the selected model beyond noise.")
+        lines.append("**Explained:** the selected model's test error is within the noise floor's interval.")
     else:
         remaining = ", ".join(f"**{entry['variable']}** (a correction for it removes {entry['strength']:.1%} of the "
-                              "error)" for entry in report["remaining"]) or "no single variable"
+                              "error)" for entry in report["remaining"]["variables"]) or "no single variable"
         lines.append(
-            f"**Not explained:** no library effect removes what remains; the learned error term "
+            f"**Not explained:** the selected model's test error is {above['trans_pct']:.1f} (translation) and "
+            f"{above['rot_pct']:.1f} (rotation) points of % above the noise floor; the learned error term "
             f"{'lowers' if fallback['beyond_noise'] else 'does not lower'} the error beyond noise, and the residual "
             f"still depends on {remaining}. Test-split sum with the learned term "
             f"{report['fallback']['trans_pct'] + report['fallback']['rot_pct']:.1f} % instead of "

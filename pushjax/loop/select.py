@@ -4,12 +4,18 @@ Every library effect is fitted alone on the fit sequences and ranked by its tran
 (% of the ``zero`` baseline) on the selection sequences (out of fold: the select split, or every pool
 sequence when cross-fitted, see :mod:`pushjax.loop.splits`). Greedy forward selection starts from the plain
 model and, in each round, fits the current set plus each remaining effect (warm-started from the current
-fit and the effect's own fit) and keeps the best addition only when it lowers the error beyond noise:
-the one-sided paired sign-flip test over selection sequences (:func:`pushjax.loop.metrics.sign_flip_pvalues`)
-must give a p-value of at most ``alpha`` over the number of candidates of the round (Bonferroni: the
-family-wise error of the round's decision is at most ``alpha``), and the point estimate of the relative
-gain must exceed ``min_gain`` (0 by default: any improvement beyond noise counts). The selected set is
-then refitted on the whole pool; the test split is never used here.
+fit and the effect's own fit; an effect that excludes some of the current ones, such as ``limit_surface``, which
+subsumes ``friction_ratio`` and ``pressure_gradient``, replaces them) and tests every candidate:
+
+* beyond noise: the one-sided paired sign-flip test over selection sequences
+  (:func:`pushjax.loop.metrics.sign_flip_pvalues`), Holm's step-down procedure over the round's candidates
+  (:func:`pushjax.loop.metrics.holm`), so the family-wise error of the round is at most ``alpha``;
+* worth having: the gain must remove more than ``min_gain`` of the error the current model has above the noise
+  floor (:func:`pushjax.loop.metrics.noise_floor` of the selection windows): close to the floor, nothing more is
+  there to explain.
+
+Among the candidates that pass both, the one with the largest gain is added; selection stops when none passes.
+The selected set is then refitted on the whole pool; the test split is never used here.
 """
 
 from __future__ import annotations
@@ -22,10 +28,10 @@ import numpy as np
 from pushjax.loop import fit as fit_lib
 from pushjax.loop import metrics
 from pushjax.loop.splits import Split
-from pushjax.physics.effects import EFFECT_NAMES
+from pushjax.physics.effects import EFFECT_NAMES, EFFECTS
 
-MIN_GAIN = 0.0
-"""Default relative cut of the selection error that an added effect's point estimate must exceed."""
+MIN_GAIN = 0.05
+"""Default share of the current model's selection error above the noise floor that an added effect must remove."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -60,7 +66,10 @@ class Round:
       additions: the effect each candidate adds.
       gains: relative selection-error cut of each over the current model (point estimates).
       p_values: one-sided sign-flip p-value of each gain.
-      level: the p-value the best addition had to reach (``alpha`` over the number of candidates).
+      levels: the level Holm's procedure compared each p-value with.
+      beyond_noise: whether Holm's procedure rejects "no gain" for each.
+      floor: the gain (points of the combined score) an addition had to exceed: ``min_gain`` times the current
+        error above the noise floor.
       accepted: the effect added in this round, or None (selection stops).
     """
 
@@ -68,7 +77,9 @@ class Round:
     additions: list[str]
     gains: list[float]
     p_values: list[float]
-    level: float
+    levels: list[float]
+    beyond_noise: list[bool]
+    floor: float
     accepted: str | None
 
 
@@ -82,6 +93,7 @@ class Selection:
       rounds: the forward-selection rounds.
       final: the selected candidate (the baseline when nothing was selected).
       model: the selected effects refitted on the whole pool (None when nothing was selected).
+      noise_floor: the noise floor of the selection windows.
     """
 
     baseline: Candidate
@@ -89,11 +101,13 @@ class Selection:
     rounds: list[Round]
     final: Candidate
     model: fit_lib.FitResult | None
+    noise_floor: metrics.NoiseFloor
 
     @property
     def selected(self) -> list[str]:
-        """Effect names in the order they were selected."""
-        return [round_.accepted for round_ in self.rounds if round_.accepted is not None]
+        """The final model's effects in the order they were selected (one replaced by a later one left out)."""
+        accepted = [round_.accepted for round_ in self.rounds if round_.accepted is not None]
+        return [name for name in accepted if name in self.final.effects]
 
 
 class _Folds:
@@ -132,7 +146,7 @@ def select_effects(
       split: the fit/select roles of the pool (:func:`pushjax.loop.splits.split`).
       effects: candidate effect names.
       settings: optimiser settings.
-      min_gain: relative selection-error cut an added effect's point estimate must exceed.
+      min_gain: share of the current selection error above the noise floor that an added effect must remove.
       alpha: family-wise error level of each round's decision.
       seed: seed of the sign-flip test.
       progress: called with a short message before each fitting round.
@@ -143,6 +157,9 @@ def select_effects(
     effects = tuple(name for name in EFFECT_NAMES if name in effects)
     report = progress or (lambda message: None)
     folds = _Folds(split)
+    selection_windows = folds.selection
+    floor = metrics.noise_floor(selection_windows.target, selection_windows.sequence, selection_windows.push,
+                                selection_windows.window, selection_windows.tracking_noise, seed=seed)
     baseline = folds.evaluate([()], [[None] for _ in folds.fit])[0]
     report(f"fitting {len(effects)} effects")
     sets = [(name,) for name in effects]
@@ -150,32 +167,50 @@ def select_effects(
     ranking = sorted(singles, key=lambda candidate: candidate.score)
     single_params = [{c.effects[0]: c.fits[k].params[c.effects[0]] for c in singles} for k in range(len(folds.fit))]
 
-    current, candidates, rounds = baseline, singles, []
+    current, candidates, additions, rounds = baseline, singles, list(effects), []
     while candidates:
         per_sequence = metrics.sequence_gains(current.errors, [c.errors for c in candidates])
-        gains = [float(g) for g in per_sequence.sum(axis=1) / current.score]
-        p_values = [float(p) for p in metrics.sign_flip_pvalues(per_sequence, seed=seed)]
-        best = int(np.argmax(gains))
-        level = alpha / len(candidates)
-        accepted = p_values[best] <= level and gains[best] > min_gain
-        additions = [[name for name in c.effects if name not in current.effects][0] for c in candidates]
-        rounds.append(Round(candidates=candidates, additions=additions, gains=gains, p_values=p_values, level=level,
-                            accepted=additions[best] if accepted else None))
-        if not accepted:
+        points = per_sequence.sum(axis=1)
+        gains = [float(g) for g in points / current.score]
+        p_values = metrics.sign_flip_pvalues(per_sequence, seed=seed)
+        beyond_noise, levels = metrics.holm(p_values, alpha)
+        required = min_gain * max(current.score - floor.score, 0.0)
+        passing = np.flatnonzero(beyond_noise & (points > required))
+        best = int(passing[np.argmax(points[passing])]) if len(passing) else None
+        rounds.append(Round(candidates=candidates, additions=additions, gains=gains,
+                            p_values=[float(p) for p in p_values], levels=[float(level) for level in levels],
+                            beyond_noise=[bool(b) for b in beyond_noise], floor=float(required),
+                            accepted=additions[best] if best is not None else None))
+        if best is None:
             break
         current = candidates[best]
-        remaining = [name for name in effects if name not in current.effects]
-        if not remaining:
+        sets, additions = _next_sets(current.effects, effects)
+        if not sets:
             break
-        report(f"fitting {current.effects} plus one of {len(remaining)} effects")
-        sets = [current.effects + (name,) for name in remaining]
+        report(f"fitting {current.effects} plus one of {len(sets)} effects")
         per_fold = [fit_lib.fit_effects(sets, fit, settings,
-                                        initial=[{**current.fits[k].params, name: single_params[k][name]}
-                                                 for name in remaining])
+                                        initial=[{**{name: current.fits[k].params[name] for name in effects_set
+                                                     if name in current.effects},
+                                                  name: single_params[k][name]}
+                                                 for effects_set, name in zip(sets, additions)])
                     for k, fit in enumerate(folds.fit)]
         candidates = folds.evaluate(sets, per_fold)
     model = None
     if current.effects:
         report(f"refitting {current.effects} on every pool sequence")
         model = fit_lib.fit_effects([current.effects], split.pool, settings, initial=[current.fits[0].params])[0]
-    return Selection(baseline=baseline, ranking=ranking, rounds=rounds, final=current, model=model)
+    return Selection(baseline=baseline, ranking=ranking, rounds=rounds, final=current, model=model,
+                     noise_floor=floor)
+
+
+def _next_sets(current: tuple[str, ...], effects: Sequence[str]) -> tuple[list[tuple[str, ...]], list[str]]:
+    """The next round's candidate sets and the effect each adds: the current set plus each remaining effect, less
+    the current effects the added one excludes; an effect that a current one excludes is not a candidate."""
+    sets, additions = [], []
+    for name in effects:
+        if name in current or any(name in EFFECTS[other].excludes for other in current):
+            continue
+        kept = tuple(other for other in current if other not in EFFECTS[name].excludes)
+        sets.append(kept + (name,))
+        additions.append(name)
+    return sets, additions

@@ -8,7 +8,8 @@ at ``t0 + horizon``, within the recording. Its model inputs are the contact anno
 displacement over the window against the object pose at ``t0`` (:func:`pushjax.geometry.annotate`;
 where the pusher stops short of the object, the contact it would make within :data:`LOOKAHEAD` further,
 with ``s = 0`` and no action), the pusher's speed and stop, the nominal limit-surface ratio of the
-object (uniform pressure) and a nominal pusher friction; its
+object (uniform pressure), its footprint as support cells (:func:`pushjax.geometry.support_cells`, for the exact
+limit surface) and a nominal pusher friction; its
 target is the displacement of the object's nominal centre of mass (the uniform plate's centroid in the
 tracked frame) and the change of yaw over the window.
 """
@@ -20,10 +21,11 @@ import dataclasses
 import math
 from collections.abc import Iterable
 
+import jax
 import numpy as np
 
 from pushjax import planar
-from pushjax.geometry import OBJECT_NAMES, PUSHER_RADIUS, annotate, get_object, limit_surface_ratio
+from pushjax.geometry import OBJECT_NAMES, PUSHER_RADIUS, annotate, get_object, limit_surface_ratio, support_cells
 from pushjax.mit.files import Push
 from pushjax.physics.effects import PushInputs
 
@@ -62,6 +64,10 @@ class Examples:
       target: [N, 3] measured displacement of the nominal centre of mass (world, m) and yaw change (rad).
       sequence: [N] int, index of the push sequence (repetitions of one push share it).
       push: [N] int, index of the push (file) in reading order.
+      window: [N] int, index of the window in its push (the same index in repetitions of a push starts at the same
+        time after the pusher's first motion).
+      tracking_noise: [N, 3] standard deviation of the pose measurement of the window's push (x m, y m, yaw rad),
+        estimated from the pose stream (:func:`tracking_noise`).
       variables: {name: [N] values} of the candidate explanatory variables (see :data:`VARIABLES`).
       sequence_names: names of the sequences, indexed by ``sequence``.
     """
@@ -70,6 +76,8 @@ class Examples:
     target: np.ndarray
     sequence: np.ndarray
     push: np.ndarray
+    window: np.ndarray
+    tracking_noise: np.ndarray
     variables: dict[str, np.ndarray]
     sequence_names: tuple[str, ...]
 
@@ -87,10 +95,9 @@ class Examples:
     def select(self, mask: np.ndarray) -> Examples:
         """The examples where ``mask`` [N] (bool or indices) selects; sequence indices are kept."""
         return Examples(
-            inputs=PushInputs(**{field.name: np.asarray(getattr(self.inputs, field.name))[mask]
-                                 for field in dataclasses.fields(PushInputs)}),
-            target=self.target[mask], sequence=self.sequence[mask], push=self.push[mask],
-            variables={name: values[mask] for name, values in self.variables.items()},
+            inputs=jax.tree.map(lambda values: np.asarray(values)[mask], self.inputs),
+            target=self.target[mask], sequence=self.sequence[mask], push=self.push[mask], window=self.window[mask],
+            tracking_noise=self.tracking_noise[mask], variables={name: values[mask] for name, values in self.variables.items()},
             sequence_names=self.sequence_names,
         )
 
@@ -127,6 +134,19 @@ def _pusher_speeds(push: Push, frequency: float) -> tuple[np.ndarray, np.ndarray
     trailing[lag:] = np.linalg.norm(xy[lag:] - xy[:-lag], axis=1) * frequency / lag
     trailing[:lag] = trailing[lag]
     return instantaneous, trailing
+
+
+def tracking_noise(pose: np.ndarray) -> np.ndarray:
+    """[3] standard deviation of white measurement noise on a [T, 3] pose stream (x m, y m, yaw rad).
+
+    The second difference of a smoothly moving pose is far below the noise at the MIT data's 250 Hz, and that of
+    white noise of variance s^2 has variance 6 s^2; its median absolute deviation (robust to the pusher's start and
+    stop) gives s.
+    """
+    second = np.diff(np.asarray(pose, np.float64), n=2, axis=0)
+    if len(second) == 0:
+        return np.zeros(3)
+    return 1.4826 * np.median(np.abs(second - np.median(second, axis=0)), axis=0) / math.sqrt(6.0)
 
 
 def _windows(push: Push, horizon: float, stride: float):
@@ -202,6 +222,8 @@ def build_examples(
             time=push.time[starts],
             sequence=np.full(len(starts), sequence),
             push=np.full(len(starts), n_pushes - 1),
+            window=np.arange(len(starts)),
+            tracking_noise=np.broadcast_to(tracking_noise(push.object), (len(starts), 3)),
             params=push.params,
         ))
     if n_pushes == 0:
@@ -209,11 +231,18 @@ def build_examples(
         raise ValueError(f"pushes: none gave a prediction window of {horizon} s ({reasons})")
 
     parts = [_annotate_object(name, object_rows, pusher_friction) for name, object_rows in sorted(rows.items())]
+    # Objects' supports have different numbers of cells: padded with zero-weight cells to the largest.
+    cells = max(part["support_points"].shape[1] for part in parts)
+    for part in parts:
+        padding = cells - part["support_points"].shape[1]
+        part["support_points"] = np.pad(part["support_points"], ((0, 0), (0, padding), (0, 0)))
+        part["support_weights"] = np.pad(part["support_weights"], ((0, 0), (0, padding)))
     merged = {key: np.concatenate([part[key] for part in parts]) for key in parts[0] if key != "variables"}
     variables = {name: np.concatenate([part["variables"][name] for part in parts]) for name in VARIABLES}
     inputs = PushInputs(**{field.name: merged[field.name] for field in dataclasses.fields(PushInputs)})
     examples = Examples(inputs=inputs, target=merged["target"], sequence=merged["sequence"], push=merged["push"],
-                        variables=variables, sequence_names=tuple(sequence_index))
+                        window=merged["window"], tracking_noise=merged["tracking_noise"], variables=variables,
+                        sequence_names=tuple(sequence_index))
     return examples, BuildSummary(n_pushes=n_pushes, skipped=dict(skipped))
 
 
@@ -242,6 +271,7 @@ def _annotate_object(name: str, rows: list[dict], pusher_friction: float) -> dic
     gap = np.where(annotated, np.sum((contact_world - tip0) * normal, axis=1) - PUSHER_RADIUS, 0.0)
     com0, com1 = planar.centre_of_mass(obj.centroid, pose0), planar.centre_of_mass(obj.centroid, pose1)
     count = len(pose0)
+    support_points, support_weights, patch_radius = support_cells(obj)
     yaw = pose0[:, 2]
     variables = {
         "push velocity": np.array([p.velocity for p in params]),
@@ -261,8 +291,12 @@ def _annotate_object(name: str, rows: list[dict], pusher_friction: float) -> dic
         l=np.full(count, limit_surface_ratio(obj)), mu=np.full(count, float(pusher_friction)),
         s=touches.astype(np.float64), object_yaw=yaw, push_speed=data["push_speed"],
         time_after_stop=data["time_after_stop"], object_position=com0,
+        support_points=np.broadcast_to(support_points, (count, *support_points.shape)),
+        support_weights=np.broadcast_to(support_weights, (count, len(support_weights))),
+        patch_radius=np.full(count, patch_radius),
         target=np.column_stack([com1 - com0, pose1[:, 2] - pose0[:, 2]]),
-        sequence=data["sequence"], push=data["push"], variables=variables,
+        sequence=data["sequence"], push=data["push"], window=data["window"], tracking_noise=data["tracking_noise"],
+        variables=variables,
     )
 
 

@@ -83,6 +83,18 @@ composed. The effects (the keys of :data:`EFFECTS`, applied in this order whatev
     ``E|r|^2 = (9/8) l^2``). One mechanism, so the shift and ``l`` move together (unlike ``cof_offset`` plus
     ``friction_ratio``).
 
+``limit_surface``  {"rim": [] -, "gradient": [2] -, object axes}
+    The exact limit surface of the support instead of Lynch's ellipsoid (which matches the exact one only at
+    pure translation and pure rotation): the quasi-static, maximal-dissipation twist of the support described by
+    ``PushInputs.support_points`` and ``support_weights`` (area weights of cells of the footprint,
+    :func:`pushjax.geometry.support_cells`), solved by :func:`pushjax.physics.limit_surface.predict`. The support
+    pressure is ``area_k exp(rim (|r_k|^2 / E|r|^2 - 1) + gradient . r_k / sqrt(E|r|^2))``: ``rim > 0`` loads the rim
+    (a plate resting on its edge spins harder), ``rim < 0`` the centre, ``gradient`` moves the centre of pressure.
+    It replaces the ellipsoid, so its zero parameters are the exact surface of a uniform pressure, not Lynch's
+    model; it cannot be composed with the effects that change the ellipsoid (:data:`EFFECTS`' ``excludes``:
+    ``friction_ratio`` and ``pressure_gradient``, which its pressure modes subsume, and ``anisotropic_friction``,
+    which the exact surface does not model).
+
 All branches are double-``where`` selections, so gradients are finite everywhere, including the
 no-effect parameters, ``normal = 0``, ``action = 0`` and ``s = 0``.
 """
@@ -96,19 +108,23 @@ import flax.struct
 import jax
 import jax.numpy as jnp
 
+from pushjax.physics import limit_surface as exact_limit_surface
 from pushjax.physics import lynch
 
 __all__ = [
     "EFFECTS",
     "EFFECT_NAMES",
+    "ELLIPSOID_EFFECTS",
     "Effect",
     "ModelState",
     "PushInputs",
+    "compatible",
     "compose",
     "init_params",
     "limit_surface_predict",
     "physical_params",
     "project_params",
+    "support_pressure",
 ]
 
 Params = dict[str, jax.Array]
@@ -136,6 +152,10 @@ class PushInputs:
       time_after_stop: [...] time from the pusher's stop to the window's end, s (0: still moving).
       object_position: [..., 2] position of the nominal centre of mass on the table at the window's start,
         world axes, m.
+      support_points: [..., K, 2] points of the object's support relative to the nominal centre of mass, object
+        axes, m (:func:`pushjax.geometry.support_cells`); None when unknown (``limit_surface`` needs them).
+      support_weights: [..., K] their area weights (>= 0, zero for padding); None with ``support_points``.
+      patch_radius: [...] the radius of a support's patch, m (the solve's regularisation length).
     """
 
     contact: jax.Array
@@ -150,20 +170,30 @@ class PushInputs:
     push_speed: jax.Array
     time_after_stop: jax.Array
     object_position: jax.Array
+    support_points: jax.Array | None = None
+    support_weights: jax.Array | None = None
+    patch_radius: jax.Array | None = None
 
     @classmethod
     def create(cls, contact, normal, action, l, mu, s=1.0, *, pusher_motion=None, gap=0.0,
-               object_yaw=0.0, push_speed=0.0, time_after_stop=0.0, object_position=(0.0, 0.0)) -> PushInputs:
+               object_yaw=0.0, push_speed=0.0, time_after_stop=0.0, object_position=(0.0, 0.0),
+               support_points=None, support_weights=None, patch_radius=None) -> PushInputs:
         """Inputs from ``lynch.predict``'s arguments; the others default to a pusher in contact
-        (``pusher_motion = action``, ``gap = 0``), object yaw 0 at the table's origin and a pusher that does
-        not stop."""
+        (``pusher_motion = action``, ``gap = 0``), object yaw 0 at the table's origin, a pusher that does
+        not stop and an unknown support."""
         action = jnp.asarray(action)
+
+        def optional(value):
+            return None if value is None else jnp.asarray(value)
+
         return cls(
             contact=jnp.asarray(contact), normal=jnp.asarray(normal), action=action,
             pusher_motion=action if pusher_motion is None else jnp.asarray(pusher_motion),
             gap=jnp.asarray(gap), l=jnp.asarray(l), mu=jnp.asarray(mu), s=jnp.asarray(s),
             object_yaw=jnp.asarray(object_yaw), push_speed=jnp.asarray(push_speed),
             time_after_stop=jnp.asarray(time_after_stop), object_position=jnp.asarray(object_position),
+            support_points=optional(support_points), support_weights=optional(support_weights),
+            patch_radius=optional(patch_radius),
         )
 
 
@@ -204,6 +234,9 @@ class Effect:
       project: params -> params inside the physically valid set.
       physical: params -> {readable name with unit: scalar}, the values to report.
       general_solver: whether the effect needs the generalised solver (not plain Lynch).
+      solve: (params, state, inputs) -> twist about the centre of friction, replacing the ellipsoidal solve, or
+        None (at most one composed effect has one).
+      excludes: effects that cannot be composed with this one.
     """
 
     name: str
@@ -214,6 +247,8 @@ class Effect:
     project: Callable[[Params], Params]
     physical: Callable[[Params], dict[str, jax.Array]]
     general_solver: bool
+    solve: Callable[[Params, ModelState, PushInputs], jax.Array] | None = None
+    excludes: tuple[str, ...] = ()
 
 
 def _rotate(vector: jax.Array, yaw: jax.Array) -> jax.Array:
@@ -409,6 +444,35 @@ def _inertia_physical(params):
             "decay_length_mm_at_100_mm_s": 1e3 * 0.5 * 0.1 ** 2 * inverse}
 
 
+def support_pressure(params: Params, points: jax.Array, area: jax.Array) -> jax.Array:
+    """[..., K] normalised support pressure of ``limit_surface`` at [..., K, 2] ``points`` (object axes, m) with
+    area weights [..., K] (see the module docstring)."""
+    area = area / jnp.sum(area, axis=-1, keepdims=True)
+    mean_square = jnp.sum(area * jnp.sum(points ** 2, axis=-1), axis=-1, keepdims=True)
+    radial = jnp.sum(points ** 2, axis=-1) / mean_square - 1.0
+    linear = jnp.sum(points * jnp.asarray(params["gradient"])[..., None, :], axis=-1) / jnp.sqrt(mean_square)
+    log_pressure = jnp.asarray(params["rim"])[..., None] * radial + linear
+    weights = area * jnp.exp(log_pressure - jnp.max(log_pressure, axis=-1, keepdims=True))
+    return weights / jnp.sum(weights, axis=-1, keepdims=True)
+
+
+def _limit_surface_solve(params, state, inputs):
+    if inputs.support_points is None or inputs.support_weights is None or inputs.patch_radius is None:
+        raise ValueError("limit_surface: needs PushInputs.support_points, support_weights and patch_radius "
+                         "(pushjax.geometry.support_cells)")
+    points = jnp.asarray(inputs.support_points)
+    pressure = support_pressure(params, points, jnp.asarray(inputs.support_weights))
+    # World axes. The support is centred where the other effects put the centre of friction (cof_offset moves the
+    # pressure with it, frame_offset the whole plate), and the contact is relative to that centre.
+    world = _rotate(points, jnp.asarray(inputs.object_yaw)[..., None])
+    return exact_limit_surface.predict(state.contact, state.normal, state.action, state.mu, world, pressure,
+                                       inputs.patch_radius, state.s, state.drift_force)
+
+
+def _limit_surface_physical(params):
+    return {"rim": params["rim"], "gradient_x": params["gradient"][..., 0], "gradient_y": params["gradient"][..., 1]}
+
+
 SPEED_REFERENCE = 0.02
 """Sliding speed (m/s) at which ``friction_speed``'s coefficient is the reference one (the MIT grid's 20 mm/s)."""
 SPEED_FLOOR = 1e-3
@@ -448,11 +512,22 @@ EFFECTS: dict[str, Effect] = {
                None, _friction_speed_correct, _friction_speed_project, _friction_speed_physical, False),
         Effect("pressure_gradient", _zeros(offset=(2,)), {"offset": 0.01}, _pressure_gradient_modify, None,
                _identity, _pressure_gradient_physical, False),
+        Effect("limit_surface", _zeros(rim=(), gradient=(2,)), {"rim": 1.0, "gradient": 0.5}, None, None,
+               _identity, _limit_surface_physical, False, solve=_limit_surface_solve,
+               excludes=("friction_ratio", "pressure_gradient", "anisotropic_friction")),
     )
 }
 """The library, in the order in which effects are applied."""
 
 EFFECT_NAMES = tuple(EFFECTS)
+ELLIPSOID_EFFECTS = tuple(name for name in EFFECT_NAMES if EFFECTS[name].solve is None)
+"""The effects that keep Lynch's ellipsoidal limit surface: any of them compose, and their zero parameters are
+Lynch's model."""
+
+
+def compatible(names: Sequence[str]) -> bool:
+    """Whether the named effects can be composed (no one excludes another)."""
+    return not any(other in names for name in names for other in EFFECTS[name].excludes)
 
 
 def _check_names(names: Sequence[str]) -> tuple[str, ...]:
@@ -461,10 +536,13 @@ def _check_names(names: Sequence[str]) -> tuple[str, ...]:
     unknown = [name for name in names if name not in EFFECTS]
     if unknown:
         raise ValueError(f"effects: unknown {', '.join(map(repr, unknown))}; known: {', '.join(EFFECT_NAMES)}")
+    clashes = [f"{name} with {other}" for name in names for other in EFFECTS[name].excludes if other in names]
+    if clashes:
+        raise ValueError(f"effects: cannot compose {', '.join(clashes)} (see pushjax.physics.effects)")
     return tuple(name for name in EFFECT_NAMES if name in names)
 
 
-def init_params(names: Sequence[str] = EFFECT_NAMES) -> dict[str, Params]:
+def init_params(names: Sequence[str] = ELLIPSOID_EFFECTS) -> dict[str, Params]:
     """The "no effect" parameters of the named effects, {effect: {parameter: zeros}}."""
     return {name: EFFECTS[name].init() for name in _check_names(names)}
 
@@ -582,6 +660,7 @@ def compose(names: Sequence[str]) -> Callable[[dict[str, Params], PushInputs], j
     """
     names = _check_names(names)
     general = any(EFFECTS[name].general_solver for name in names)
+    solvers = [name for name in names if EFFECTS[name].solve is not None]
 
     def predict(params_by_effect: dict[str, Params], inputs: PushInputs) -> jax.Array:
         missing = [name for name in names if name not in params_by_effect]
@@ -600,7 +679,9 @@ def compose(names: Sequence[str]) -> Callable[[dict[str, Params], PushInputs], j
         for name in names:
             if EFFECTS[name].modify is not None:
                 state = EFFECTS[name].modify(params_by_effect[name], state, inputs)
-        if general:
+        if solvers:
+            twist = EFFECTS[solvers[0]].solve(params_by_effect[solvers[0]], state, inputs)
+        elif general:
             twist = limit_surface_predict(state.contact, state.normal, state.action, state.l, state.mu, state.s,
                                           state.metric, state.drift_force)
         else:

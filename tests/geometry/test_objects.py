@@ -7,7 +7,7 @@ import pytest
 import shapely
 import trimesh
 
-from pushjax.geometry import OBJECT_NAMES, get_object, limit_surface_ratio
+from pushjax.geometry import OBJECT_NAMES, get_object, limit_surface_ratio, support_cells
 
 # The dataset's .obj files are Y-up: the plate's plane is the mesh's (x, z), which maps to the
 # object's (x, y) unchanged (the right-angle corner of the triangles is at mesh (+45, +45) mm).
@@ -147,3 +147,15 @@ def test_side_normal_of_rect_centre():
     point, normal = get_object("rect3").side_point(0, 0.5)
     np.testing.assert_allclose(point, [0.0675, 0.0], atol=1e-15)
     np.testing.assert_allclose(normal, [-1.0, 0.0], atol=1e-15)
+
+
+@pytest.mark.parametrize("name", OBJECT_NAMES)
+def test_support_cells_cover_the_footprint_with_its_area(name):
+    obj = get_object(name)
+    points, weights, radius = support_cells(obj)
+    assert 24 <= len(points) <= 64 and points.shape == (len(points), 2)
+    np.testing.assert_allclose(weights.sum(), 1.0)
+    np.testing.assert_allclose(weights @ points, 0.0, atol=1e-12)  # centred: uniform pressure at the COM
+    # The cells' mean distance from the centre is the uniform plate's l, within the cells' discretisation.
+    assert abs(weights @ np.linalg.norm(points, axis=1) / limit_surface_ratio(obj) - 1) < 0.025
+    assert 0 < radius < 0.01

@@ -32,3 +32,47 @@ def test_predictive_scores_of_a_calibrated_gaussian():
     assert abs(scores["coverage_68"] - 0.68) < 0.01 and abs(scores["coverage_95"] - 0.95) < 0.01
     too_narrow = metrics.predictive_scores(np.zeros((count, 3)), 0.5 * std, world, yaw)
     assert too_narrow["nlpd"] > scores["nlpd"] and too_narrow["coverage_95"] < 0.9
+
+
+def test_holm_steps_down_from_the_smallest_p_value():
+    rejected, levels = metrics.holm(np.array([0.04, 0.001, 0.015, 0.3]), alpha=0.05)
+    np.testing.assert_allclose(levels, [0.05 / 2, 0.05 / 4, 0.05 / 3, 0.05])
+    # 0.001 <= 0.0125 and 0.015 <= 0.0167 pass; 0.04 > 0.025 stops the procedure, so 0.3 fails too.
+    np.testing.assert_array_equal(rejected, [False, True, True, False])
+    # Bonferroni would keep only the smallest; Holm passes every p-value below its level in turn.
+    assert metrics.holm(np.array([0.01, 0.02]), alpha=0.05)[0].all()
+
+
+def _repeated_windows(rng, sequences, repeats, windows, spread):
+    """Targets of `repeats` pushes per sequence whose windows share an expected motion, plus Gaussian spread."""
+    expected = rng.normal(0, [5e-3, 5e-3, 0.05], size=(sequences, windows, 3))
+    target = expected[:, None] + rng.normal(size=(sequences, repeats, windows, 3)) * spread
+    index = np.indices((sequences, repeats, windows)).reshape(3, -1)
+    return target.reshape(-1, 3), expected[index[0], index[2]], index[0], index[0] * repeats + index[1], index[2]
+
+
+def test_noise_floor_from_repeats_is_the_error_of_the_true_expected_motion():
+    rng = np.random.default_rng(0)
+    spread = np.array([4e-4, 4e-4, 0.004])
+    target, expected, sequence, push, window = _repeated_windows(rng, 60, 3, 8, spread)
+    floor = metrics.noise_floor(target, sequence, push, window, np.zeros((len(target), 3)))
+    oracle = metrics.summarize(metrics.window_errors(expected, target, sequence))
+    assert floor.source == "repeats" and floor.n_windows == len(target)
+    assert abs(floor.trans_pct - oracle["trans_pct"]) < 0.05 * oracle["trans_pct"]
+    assert abs(floor.rot_pct - oracle["rot_pct"]) < 0.05 * oracle["rot_pct"]
+    for key in ("trans_pct", "rot_pct"):
+        low, high = floor.interval[key]
+        assert low < getattr(floor, key) < high
+
+
+def test_noise_floor_without_repeats_comes_from_the_tracking_noise():
+    rng = np.random.default_rng(1)
+    noise = np.array([3e-4, 3e-4, 0.003])
+    target, expected, sequence, push, window = _repeated_windows(rng, 80, 1, 8, np.zeros(3))
+    # Each target is the difference of two poses with white noise: sqrt(2) times the per-pose noise per axis.
+    measured = target + rng.normal(size=target.shape) * np.sqrt(2) * noise
+    floor = metrics.noise_floor(measured, sequence, push, window, np.broadcast_to(noise, target.shape))
+    oracle = metrics.summarize(metrics.window_errors(expected, measured, sequence))
+    assert floor.source == "tracking"
+    assert abs(floor.trans_pct - oracle["trans_pct"]) < 0.1 * oracle["trans_pct"]
+    assert abs(floor.rot_pct - oracle["rot_pct"]) < 0.1 * oracle["rot_pct"]

@@ -1,8 +1,9 @@
 """The mission's own test: the loop finds effects nobody declared in testbed data.
 
 Every data set is recorded with ``declare_effects=False``, so its files hold exactly what real MIT files
-hold. The loop must name the injected effect first and cut the test-split error (push sequences that took
-no part in fitting or selecting) by at least 30 %. Clean data, two effects at once and an effect outside
+hold. The loop must name the injected effect, name nothing else but what any simulator differs in from Lynch's model
+(:data:`REAL_DIFFERENCES`), and cut the test-split error (push sequences that took no part in fitting or selecting) by
+at least 30 %. Clean data, two effects at once and an effect outside
 the library: test_beyond_one_effect.py.
 """
 
@@ -13,26 +14,34 @@ import pytest
 
 from pushjax.loop.metrics import combined
 from pushjax.physics.effects import EFFECT_NAMES
+from pushjax.sim.effects import Effects
 
-from .conftest import CASES
+from .conftest import CASES, REAL_DIFFERENCES
 
 SUMMARY_KEYS = {"trans_pct", "rot_pct", "trans_mm", "rot_deg"}
-SINGLE = [name for name, case in CASES.items() if case.expected and "_and_" not in name]
+SINGLE = [name for name, case in CASES.items() if case.effects != Effects() and case.expected and "_and_" not in name]
 
 
 @pytest.mark.parametrize("name", SINGLE)
-def test_injected_effect_is_selected_first_and_cuts_the_test_error(name, loop_report):
+def test_injected_effect_is_selected_with_no_false_discovery_and_cuts_the_test_error(name, loop_report):
     report, _ = loop_report(name)
-    assert report["selected"][:1] and report["selected"][0] in CASES[name].expected, report["selected"]
+    selected = set(report["selected"])
+    assert selected & CASES[name].expected, report["selected"]
+    assert selected <= CASES[name].expected | REAL_DIFFERENCES, report["selected"]
     assert combined(report["after"]) <= 0.7 * combined(report["baseline"])
-    assert report["ranking"][0]["effect"] in CASES[name].expected
 
 
 def test_report_follows_the_schema(loop_report):
     report, workdir = loop_report("com_offset")
     assert json.loads((workdir / "report.json").read_text()) == report
-    assert set(report) == {"n_pushes", "baseline", "diagnosis", "ranking", "selected", "after", "explained",
-                           "fallback", "remaining", "uncertainty"}
+    assert set(report) == {"n_pushes", "baseline", "diagnosis", "ranking", "selected", "after", "noise_floor",
+                           "explained", "fallback", "remaining", "uncertainty"}
+    floor = report["noise_floor"]
+    assert floor["source"] == "tracking" and floor["n_windows"] > 0  # no push is repeated
+    assert set(report["remaining"]) == {"above_floor", "variables"}
+    for key in ("trans_pct", "rot_pct"):
+        assert 0 <= floor["interval"][key][0] <= floor[key] <= floor["interval"][key][1]
+        assert report["remaining"]["above_floor"][key] == pytest.approx(report["after"][key] - floor[key])
     assert report["n_pushes"] == {"fit": 67, "select": 90, "test": 30, "skipped": 0}  # cross-fitted: every pool push selects
     for key in ("baseline", "after", "fallback"):
         assert set(report[key]) == SUMMARY_KEYS | {"interval"} and set(report[key]["interval"]) == SUMMARY_KEYS
@@ -50,7 +59,7 @@ def test_report_follows_the_schema(loop_report):
     scores = [combined(entry["select"]) for entry in report["ranking"]]
     assert scores == sorted(scores)
     # The offset is recovered within a few standard errors (the testbed moved the COM by (15, -10) mm).
-    offset = report["ranking"][0]["params"]
+    offset = next(entry["params"] for entry in report["ranking"] if entry["effect"] == "cof_offset")
     for axis, true in (("offset_x_mm", 15.0), ("offset_y_mm", -10.0)):
         assert abs(offset[axis]["value"] - true) < max(4 * offset[axis]["std"], 2.0)
     markdown = (workdir / "report.md").read_text()

@@ -57,7 +57,7 @@ def _random_params(seed):
     }
 
 
-@pytest.mark.parametrize("names", [(), *[(name,) for name in effects.EFFECT_NAMES], effects.EFFECT_NAMES])
+@pytest.mark.parametrize("names", [(), *[(name,) for name in effects.ELLIPSOID_EFFECTS], effects.ELLIPSOID_EFFECTS])
 def test_no_effect_parameters_reproduce_lynch(names):
     inputs = _random_inputs(0)
     predicted = jax.jit(effects.compose(names))(effects.init_params(names), inputs)
@@ -78,7 +78,7 @@ def test_gradients_are_finite_at_no_effect_and_degenerate_inputs():
     zero = jnp.zeros_like(inputs.normal)
     degenerate = [inputs, inputs.replace(normal=zero), inputs.replace(action=zero, pusher_motion=zero),
                   inputs.replace(s=jnp.zeros_like(inputs.s)), inputs.replace(contact=zero)]
-    model = effects.compose(effects.EFFECT_NAMES)
+    model = effects.compose(effects.ELLIPSOID_EFFECTS)
     for case, params in itertools.product(degenerate, (effects.init_params(), _random_params(3))):
         gradient = jax.grad(lambda p, i: jnp.sum(model(p, i) ** 2), argnums=(0, 1))(params, case)
         assert all(np.all(np.isfinite(leaf)) for leaf in jax.tree.leaves(gradient))
@@ -86,18 +86,18 @@ def test_gradients_are_finite_at_no_effect_and_degenerate_inputs():
 
 def test_gradient_at_no_effect_points_somewhere_for_every_effect():
     inputs = _random_inputs(4, count=2000)
-    target = effects.compose(effects.EFFECT_NAMES)(_random_params(5), inputs)
-    model = effects.compose(effects.EFFECT_NAMES)
+    target = effects.compose(effects.ELLIPSOID_EFFECTS)(_random_params(5), inputs)
+    model = effects.compose(effects.ELLIPSOID_EFFECTS)
     gradient = jax.grad(lambda p: jnp.sum((model(p, inputs) - target) ** 2))(effects.init_params())
-    for name in effects.EFFECT_NAMES:
+    for name in effects.ELLIPSOID_EFFECTS:
         assert any(np.any(np.asarray(leaf) != 0) for leaf in jax.tree.leaves(gradient[name])), name
 
 
 def test_composition_order_does_not_matter_and_names_are_checked():
     inputs = _random_inputs(6, count=500)
     params = _random_params(7)
-    forward = effects.compose(effects.EFFECT_NAMES)(params, inputs)
-    backward = effects.compose(effects.EFFECT_NAMES[::-1])(params, inputs)
+    forward = effects.compose(effects.ELLIPSOID_EFFECTS)(params, inputs)
+    backward = effects.compose(effects.ELLIPSOID_EFFECTS[::-1])(params, inputs)
     np.testing.assert_array_equal(forward, backward)
     with pytest.raises(ValueError, match="unknown 'gravity'"):
         effects.compose(["gravity"])
@@ -107,7 +107,7 @@ def test_composition_order_does_not_matter_and_names_are_checked():
 
 def test_vmaps_over_parameter_sets():
     inputs = _random_inputs(8, count=300)
-    model = effects.compose(effects.EFFECT_NAMES)
+    model = effects.compose(effects.ELLIPSOID_EFFECTS)
     stacked = jax.tree.map(lambda *leaves: jnp.stack(leaves), *(_random_params(seed) for seed in range(3)))
     batched = jax.jit(jax.vmap(model, in_axes=(0, None)))(stacked, inputs)
     for k in range(3):
@@ -329,3 +329,67 @@ def test_friction_speed_is_inertia_at_zero_gain_and_shortens_fast_slides_when_ra
     np.testing.assert_allclose(float(speed_model(0.3)[0]) - plain, (float(inertia[0]) - plain) / 1.3, rtol=1e-5)
     gradient = jax.grad(lambda gain: speed_model(gain)[0])(0.0)
     assert np.isfinite(gradient) and gradient < 0
+
+
+def _square_support(half=0.04, cells=10):
+    """A uniform square plate of side 2 half as cells [K, 2] with equal weights, and the cells' patch radius."""
+    centres = (np.arange(cells) + 0.5) / cells * 2 * half - half
+    points = np.stack(np.meshgrid(centres, centres), axis=-1).reshape(-1, 2)
+    return points, np.full(len(points), 1.0 / len(points)), 0.3826 * 2 * half / cells
+
+
+def _pushes_on_a_square(count=200, seed=0):
+    """Pushes on the square's bottom side (y = -0.04, normal +y), contact along it, directions within 60 deg of it."""
+    rng = np.random.default_rng(seed)
+    points, weights, radius = _square_support()
+    contact = np.column_stack([rng.uniform(-0.035, 0.035, count), np.full(count, -0.04)])
+    angle = np.pi / 2 + rng.uniform(-1, 1, count) * np.radians(60)
+    action = 0.005 * np.column_stack([np.cos(angle), np.sin(angle)])
+    return effects.PushInputs.create(
+        contact, np.tile([0.0, 1.0], (count, 1)), action, np.full(count, effects.MEAN_SQUARE_RADIUS),
+        np.full(count, 0.3), object_yaw=rng.uniform(-np.pi, np.pi, count) * 0,
+        support_points=np.broadcast_to(points, (count, *points.shape)),
+        support_weights=np.broadcast_to(weights, (count, len(weights))), patch_radius=np.full(count, radius))
+
+
+def test_limit_surface_is_the_exact_surface_of_the_support_and_moves_with_its_pressure():
+    inputs = _pushes_on_a_square()
+    model = jax.jit(effects.compose(["limit_surface"]))
+    zero = effects.init_params(["limit_surface"])
+    uniform = np.asarray(model(zero, inputs))
+    l = float(np.mean(np.linalg.norm(inputs.support_points[0], axis=1)))  # the uniform square's l
+    ellipsoid = np.asarray(lynch.predict(inputs.contact, inputs.normal, inputs.action, l, inputs.mu))
+    # The two surfaces agree at the intercepts (a push through the centre translates, both the same), and differ in
+    # between: near pure translation the exact surface gives way to a turn more easily than the ellipsoid.
+    centred = inputs.replace(contact=jnp.zeros_like(inputs.contact).at[:, 1].set(-0.04),
+                             action=jnp.tile(jnp.array([0.0, 0.005]), (len(inputs.mu), 1)))
+    np.testing.assert_allclose(model(zero, centred)[:, :2], np.tile([0.0, 0.005], (len(inputs.mu), 1)), atol=1e-6)
+    np.testing.assert_allclose(model(zero, centred)[:, 2], 0.0, atol=1e-5)
+    assert np.mean(np.abs(uniform - ellipsoid)) > 1e-5
+    # Loading the rim makes turning harder; loading the centre easier.
+    rim = {"limit_surface": {"rim": jnp.asarray(1.0), "gradient": jnp.zeros(2)}}
+    centre = {"limit_surface": {"rim": jnp.asarray(-1.0), "gradient": jnp.zeros(2)}}
+    turned = np.abs(uniform[:, 2]) > 1e-3
+    assert np.all(np.abs(np.asarray(model(rim, inputs))[turned, 2]) < np.abs(uniform[turned, 2]))
+    assert np.all(np.abs(np.asarray(model(centre, inputs))[turned, 2]) > np.abs(uniform[turned, 2]))
+    # A pressure rising towards +x moves the centre of pressure there: a push through the centre of mass then turns
+    # the plate about the heavier side (counter-clockwise for a push along +y).
+    heavy_x = {"limit_surface": {"rim": jnp.asarray(0.0), "gradient": jnp.array([1.0, 0.0])}}
+    assert np.all(np.asarray(model(heavy_x, centred))[:, 2] > 1e-4)
+
+
+def test_limit_surface_is_differentiable_and_refuses_what_it_cannot_compose():
+    inputs = _pushes_on_a_square(count=50, seed=1)
+    names = [name for name in effects.EFFECT_NAMES if effects.compatible([name, "limit_surface"])]
+    model = effects.compose(names)
+    params = {name: values for name, values in _random_params(3).items() if name in names}
+    params["limit_surface"] = {"rim": jnp.asarray(0.3), "gradient": jnp.array([0.2, -0.1])}
+    gradient = jax.grad(lambda p: jnp.sum(model(p, inputs) ** 2))(params)
+    assert all(np.all(np.isfinite(leaf)) for leaf in jax.tree.leaves(gradient))
+    assert np.all(np.asarray(gradient["limit_surface"]["gradient"]) != 0)
+    assert set(effects.EFFECT_NAMES) - set(names) == {"friction_ratio", "pressure_gradient", "anisotropic_friction"}
+    with pytest.raises(ValueError, match="cannot compose limit_surface with friction_ratio"):
+        effects.compose(["friction_ratio", "limit_surface"])
+    bare = inputs.replace(support_points=None, support_weights=None, patch_radius=None)
+    with pytest.raises(ValueError, match="limit_surface: needs PushInputs.support_points"):
+        effects.compose(["limit_surface"])(effects.init_params(["limit_surface"]), bare)
