@@ -331,9 +331,16 @@ def solve(contact, normal, action, mu, support_points, support_weights, patch_ra
     # G . V(t) = g . (a - t k x c): linear coefficient of t is g . (c_y, -c_x); of sigma, g . e.
     beta_t = gx * cy - gy * cx
 
-    # Sticking: a = u / |u|, 1-D in t.
+    # Sticking: a = u / |u|, 1-D in t. Guess: the minimiser on the ellipsoid, where the dissipation along
+    # the line is one hyperbola sqrt(alpha t^2 + 2 beta t + 1) (centroid velocity u - t k x c') plus the
+    # drift term -g . v = -beta_t t: t = t_c + h tau / sqrt(1 - tau^2), tau = beta_t / sqrt(alpha),
+    # t_c = -beta / alpha, h^2 = (1 - beta^2 / alpha) / alpha.
     stick_problem = _Problem(unit_ux, unit_uy, zero, zero, zero, beta_t, dx, dy, p, rho)
-    t0 = jax.lax.stop_gradient((ccx * unit_uy - ccy * unit_ux) / (l2 + ccx * ccx + ccy * ccy))
+    alpha = l2 + ccx * ccx + ccy * ccy
+    beta = ccy * unit_ux - ccx * unit_uy  # -(c' x u)
+    tau = jnp.clip(beta_t / jnp.sqrt(alpha), -0.95, 0.95)
+    t0 = -beta / alpha + jnp.sqrt(jnp.maximum(1 - beta * beta / alpha, 0) / alpha) * tau / jnp.sqrt(1 - tau * tau)
+    t0 = jax.lax.stop_gradient(t0)
     _, t_stick = _solve_x(False, stick_iterations, stick_problem, zero, t0)
     z1, z2, z3, inverse = _patch_velocities(stick_problem, zero, t_stick)
     force_x = _sum(p * z1 * inverse) - gx
@@ -349,11 +356,19 @@ def solve(contact, normal, action, mu, support_points, support_weights, patch_ra
     a0x, a0y = bx / b2, by / b2
     ex, ey = -by / b_length, bx / b_length
     slip_problem = _Problem(a0x, a0y, ex, ey, gx * ex + gy * ey, beta_t, dx, dy, p, rho)
-    # Ellipsoid guess: twist about the centroid ~ (l^2 f_b, c' x f_b), scaled to f_b . J V = 1.
-    omega = ccx * by - ccy * bx
-    kappa = 1 / (l2 * b2 + omega * omega)
-    velocity_x, velocity_y = kappa * (l2 * bx - omega * ccy), kappa * (l2 * by + omega * ccx)
-    sigma0 = jax.lax.stop_gradient(velocity_x * ex + velocity_y * ey)
+    # Guess: the ellipsoid's slipping twist. About the centroid the wrench (lambda f_b + g, lambda m_b + m_g)
+    # (m_b = c' x f_b, m_g = -centroid x g) lies on |f|^2 + m^2 / l^2 = 1, and the twist is (f, m / l^2);
+    # scaled to f_b . J V = 1.
+    m_b = ccx * by - ccy * bx
+    m_g = centroid_y * gx - centroid_x * gy
+    quadratic = b2 + m_b * m_b / l2
+    linear = bx * gx + by * gy + m_b * m_g / l2
+    constant = gx * gx + gy * gy + m_g * m_g / l2 - 1
+    lam = (-linear + jnp.sqrt(jnp.maximum(linear * linear - quadratic * constant, 0))) / quadratic
+    omega = (lam * m_b + m_g) / l2
+    velocity_x, velocity_y = lam * bx + gx - omega * ccy, lam * by + gy + omega * ccx  # contact velocity
+    kappa = 1 / jnp.maximum(velocity_x * bx + velocity_y * by, jnp.finfo(dtype).tiny * 1e8)
+    sigma0 = jax.lax.stop_gradient(kappa * (velocity_x * ex + velocity_y * ey))
     slip_t0 = jax.lax.stop_gradient(kappa * omega)
     sigma, t_slip = _solve_x(True, slip_iterations, slip_problem, sigma0, slip_t0)
     slip_ax, slip_ay = a0x + sigma * ex, a0y + sigma * ey
