@@ -63,8 +63,17 @@ import numpy as np
 
 __all__ = ["ITERATIONS", "STEP_LIMIT", "Solution", "dissipation", "predict", "solve"]
 
-ITERATIONS = {"stick": 8, "slip": 10}
-"""Default Newton iterations of the sticking (1-D) and slipping (2-D) solves (see BENCHMARKS.md)."""
+ITERATIONS = {"stick": 7, "slip": 8}
+"""Default Newton iterations of the sticking (1-D) and slipping (2-D) solves.
+
+Measured in float64 on 1000 random pushes per case (uniform disc grids of K = 24 and 64 points with random
+weights, contacts at 0.3-1.5 radii, mu in [0, 1.5], with and without a drift force of 0.36), largest relative
+twist error against 60 iterations: with the patch radius about half the grid spacing (rho ~ R / 10), the
+sticking solve reaches 1e-9 after 5 iterations and 1e-15 after 6, the slipping solve 1e-7 after 5 and 1e-13
+after 6 (float32's precision is reached one iteration earlier). Smaller patches sharpen the kinks and cost
+more: rho = R / 50 needs 8 (sticking) and 10 (slipping) iterations for 1e-15, and the defaults give about
+3e-8 and 1e-6 there; rho = R / 5000 needs about 24 and 40. Pass larger counts for small patches.
+"""
 
 STEP_LIMIT = 0.9
 """Largest relative change ``|dz_k| / |z_k|`` of any patch velocity in one Newton step."""
