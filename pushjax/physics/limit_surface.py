@@ -227,8 +227,11 @@ def _solve_x_jvp(two_d, iterations, primals, tangents):
     x = _solve_x(two_d, iterations, problem, sigma0, t0)
     x = jax.lax.stop_gradient(x)
     # Implicit function theorem on grad_x f(x, problem) = 0: dx = -H^-1 d(grad_x f)/d(problem) dproblem.
-    _, d_gradient = jax.jvp(lambda q: _derivatives(q, *x, two_d)[0], (problem,), (tangents[0],))
-    _, hessian, _ = _derivatives(problem, *x, two_d)
+    def gradient_and_hessian(q):
+        gradient, hessian, _ = _derivatives(q, *x, two_d)
+        return gradient, hessian
+
+    _, d_gradient, hessian = jax.jvp(gradient_and_hessian, (problem,), (tangents[0],), has_aux=True)
     step = _newton_step(d_gradient, hessian)
     return x, step
 
