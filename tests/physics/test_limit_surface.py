@@ -79,12 +79,14 @@ def test_matches_independent_scipy_reference(name):
 
 
 def test_central_push_on_a_symmetric_support_translates():
-    points = np.concatenate([_sunflower(24), -_sunflower(24)])  # point symmetric about the origin
+    # Point symmetric about the origin, padded to 64 supports (as the next tests, which then share a compilation).
+    points = np.concatenate([_sunflower(24), -_sunflower(24), np.full((16, 2), 0.02)])
+    weights = np.concatenate([np.ones(48), np.zeros(16)])
     with jax.enable_x64(True):
         for angle in (0.0, 0.7, 2.0):
             direction = np.array([np.cos(angle), np.sin(angle)])
             solution = limit_surface.solve(-RADIUS * direction, direction, 0.01 * direction, 0.3, points,
-                                           np.ones(48), 0.004)
+                                           weights, 0.004)
             np.testing.assert_allclose(solution.twist, [*(0.01 * direction), 0.0], atol=1e-14)
             # A translating support pushes back with the full friction force, along the motion.
             np.testing.assert_allclose(solution.force, direction, atol=1e-12)
@@ -249,35 +251,51 @@ _loss_value = jax.jit(_loss)
 _loss_gradient = jax.jit(jax.grad(_loss, argnums=tuple(range(1, 10))))
 
 
-def test_gradients_match_central_differences(disc_pushes):
-    rng = np.random.default_rng(5)
-    contact, normal, action, mu, points, weights, rho, s, drift = disc_pushes
+SMALL_SUPPORT = (np.array([[0.0, 0.0], [0.02, 0.01], [-0.01, 0.02], [0.03, -0.02], [0.01, 0.01]]),
+                 np.array([1.0, 2.0, 1.0, 0.5, 0.0]), 0.005)
+"""Four support points and a zero-weight padding point, shared by the gradient tests (one compilation)."""
+
+
+def _regular_pushes():
+    """8 pushes on SMALL_SUPPORT away from the stick/slip switch: 3 sticking, 3 slipping left, 2 right."""
+    rng = np.random.default_rng(6)
+    contact, normal, action, mu, s = _random_pushes(rng, 400)
+    contact, normal = (contact * 0.8)[5:], normal[5:] / np.linalg.norm(normal[5:], axis=-1, keepdims=True)
+    action, mu, s = action[5:], mu[5:], s[5:]
+    drift = np.where(np.arange(395)[:, None] % 2 == 0, 0.0, rng.uniform(-0.2, 0.2, (395, 2)))
+    points, weights, rho = SMALL_SUPPORT
     with jax.enable_x64(True):
-        base = limit_surface.solve(*disc_pushes)
-    sides = np.sign(normal[:, 0] * np.asarray(base.force)[:, 1] - normal[:, 1] * np.asarray(base.force)[:, 0])
-    # One sticking push and a push slipping on each side (with drift), each away from the stick/slip switch.
-    chosen = [np.flatnonzero(base.sticking)[0], np.flatnonzero(base.slipping & (sides > 0))[0],
-              np.flatnonzero(base.slipping & (sides < 0))[0]]
-    for index in chosen:
-        args = [contact[index], normal[index], action[index], mu[index], points, weights, rho, s[index], drift[index]]
-        args = [np.asarray(x, float) for x in args]
-        weights_out = (rng.normal(size=3) * [1, 1, RADIUS], rng.normal(size=2) * 1e-2)
-        with jax.enable_x64(True):
-            gradients = _loss_gradient(weights_out, *args)
-            for position, (arg, gradient) in enumerate(zip(args, gradients)):
-                step = 1e-6 * max(np.max(np.abs(arg)), 1e-2)
-                # Every component, but only the first 4 of the 24 supports (the others are the same code).
-                entries = np.arange(min(arg.size, 8))
-                numeric = np.zeros(len(entries))
-                for j in entries:
-                    delta = np.zeros(arg.size)
-                    delta[j] = step
-                    plus = [*args[:position], arg + delta.reshape(arg.shape), *args[position + 1:]]
-                    minus = [*args[:position], arg - delta.reshape(arg.shape), *args[position + 1:]]
-                    numeric[j] = (_loss_value(weights_out, *plus) - _loss_value(weights_out, *minus)) / (2 * step)
-                np.testing.assert_allclose(np.ravel(gradient)[entries], numeric, rtol=1e-5,
-                                           atol=1e-7 * np.max(np.abs(numeric)) + 1e-10,
-                                           err_msg=f"push {index}, argument {position}")
+        solution = limit_surface.solve(contact, normal, action, mu, points, weights, rho, s, drift)
+        # The sticking force (all stick with mu = 1e9), whose angle to the cone edge is the distance to the switch.
+        force = np.asarray(limit_surface.solve(contact, normal, action, np.full(395, 1e9), points, weights, rho, s, drift).force)
+    angle = np.arctan2(normal[:, 0] * force[:, 1] - normal[:, 1] * force[:, 0], np.sum(normal * force, -1))
+    unit_action = action / np.linalg.norm(action, axis=-1, keepdims=True)
+    clear = (np.abs(np.abs(angle) - np.arctan(mu)) > 0.05) & (np.sum(unit_action * normal, -1) > 0.1)
+    chosen = np.concatenate([np.flatnonzero(clear & solution.sticking)[:3],
+                             np.flatnonzero(clear & solution.slipping & (angle > 0))[:3],
+                             np.flatnonzero(clear & solution.slipping & (angle < 0))[:2]])
+    assert len(chosen) == 8
+    return [np.asarray(x, float) for x in (contact[chosen], normal[chosen], action[chosen], mu[chosen], points,
+                                           weights, rho, s[chosen], drift[chosen])]
+
+
+def test_gradients_match_central_differences():
+    rng = np.random.default_rng(5)
+    args = _regular_pushes()
+    weights_out = (rng.normal(size=(8, 3)) * [1, 1, RADIUS], rng.normal(size=(8, 2)) * 1e-2)
+    with jax.enable_x64(True):
+        gradients = _loss_gradient(weights_out, *args)
+        for position, (arg, gradient) in enumerate(zip(args, gradients)):
+            step = 1e-6 * max(np.max(np.abs(arg)), 1e-2)
+            numeric = np.zeros(arg.size)
+            for j in range(arg.size):
+                delta = np.zeros(arg.size)
+                delta[j] = step
+                plus = [*args[:position], arg + delta.reshape(arg.shape), *args[position + 1:]]
+                minus = [*args[:position], arg - delta.reshape(arg.shape), *args[position + 1:]]
+                numeric[j] = (_loss_value(weights_out, *plus) - _loss_value(weights_out, *minus)) / (2 * step)
+            np.testing.assert_allclose(np.ravel(gradient), numeric, rtol=1e-5,
+                                       atol=1e-7 * np.max(np.abs(numeric)) + 1e-10, err_msg=f"argument {position}")
 
 
 DEGENERATE = {
@@ -286,24 +304,34 @@ DEGENERATE = {
     "pulling": dict(action=[-0.01, 0.0]),
     "s = 0": dict(s=0.0),
     "contact on a support point": dict(contact=[0.0, 0.0]),
+    "contact on the padding point": dict(contact=[0.01, 0.01]),
     "frictionless": dict(mu=0.0),
-    "zero weight padding": dict(weights=[1.0, 2.0, 0.0, 0.0]),
     "drift": dict(drift=[0.2, 0.1]),
 }
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
 def test_gradients_are_finite_on_degenerate_pushes(dtype):
-    base = dict(contact=[-0.03, 0.01], normal=[1.0, 0.0], action=[0.01, 0.003], mu=0.3,
-                points=[[0.0, 0.0], [0.02, 0.01], [-0.01, 0.02], [0.03, -0.02]], weights=[1.0, 2.0, 1.0, 0.5],
-                rho=0.005, s=1.0, drift=[0.0, 0.0])
-    names = list(base)
+    base = dict(contact=[-0.03, 0.01], normal=[1.0, 0.0], action=[0.01, 0.003], mu=0.3, s=1.0, drift=[0.0, 0.0])
     cases = [{**base, **change} for change in DEGENERATE.values()]
+    points, weights, rho = SMALL_SUPPORT
+    batch = [np.asarray([case[name] for case in cases], float) for name in ("contact", "normal", "action", "mu")]
+    batch += [points, weights, np.asarray(rho, float)]
+    batch += [np.asarray([case[name] for case in cases], float) for name in ("s", "drift")]
+    weights_out = (np.ones((8, 3)), np.ones((8, 2)))
     with jax.enable_x64(dtype == np.float64):
-        batch = [jnp.asarray([case[name] for case in cases], dtype) for name in names]
-        gradients = _loss_gradient((jnp.ones(3, dtype), jnp.ones(2, dtype)), *batch)
-        for name, gradient in zip(names, gradients):
-            assert np.all(np.isfinite(gradient)), name
-        twist = limit_surface.predict(*batch)
-    assert np.all(np.asarray(twist)[:4] == 0)  # no contact, no action, pulling, s = 0
-    assert np.all(np.asarray(twist)[4:, 0] > 0)
+        gradients = _loss_gradient(jax.tree.map(lambda x: jnp.asarray(x, dtype), weights_out),
+                                   *(jnp.asarray(x, dtype) for x in batch))
+    for name, gradient in zip(("contact", "normal", "action", "mu", "points", "weights", "rho", "s", "drift"),
+                              gradients):
+        assert gradient.dtype == dtype
+        assert np.all(np.isfinite(gradient)), name
+    with jax.enable_x64(True):
+        # Each push's twist (dx, dy, dtheta) through the loss compiled for test_gradients_match_central_differences.
+        twist = np.zeros((8, 3))
+        for i, j in np.ndindex(8, 3):
+            selection = np.zeros((8, 3))
+            selection[i, j] = 1.0
+            twist[i, j] = _loss_value((selection, np.zeros((8, 2))), *batch)
+    assert np.all(twist[:4] == 0)  # no contact, no action, pulling, s = 0
+    assert np.all(twist[4:, 0] > 0)
