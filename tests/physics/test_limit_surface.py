@@ -53,7 +53,7 @@ def _supports(rng, name):
 def test_matches_independent_scipy_reference(name):
     rng = np.random.default_rng(0 if name == "disc" else 1)
     points, weights, rho = _supports(rng, name)
-    count = 90
+    count = 128
     contact, normal, action, mu, s = _random_pushes(rng, count)
     drift = np.where(np.arange(count)[:, None] % 2 == 0, 0.0, rng.uniform(-0.25, 0.25, (count, 2)))
     with jax.enable_x64(True):
@@ -177,8 +177,8 @@ def test_small_rotations_differ_from_lynch_by_the_second_moment():
 def disc_pushes():
     rng = np.random.default_rng(4)
     points, weights, rho = _supports(rng, "disc")
-    contact, normal, action, mu, s = _random_pushes(rng, 90)  # 90 pushes on 24 supports as above: one compilation
-    drift = rng.uniform(-0.2, 0.2, (90, 2))
+    contact, normal, action, mu, s = _random_pushes(rng, 128)  # 128 pushes on 24 supports as above: one compilation
+    drift = rng.uniform(-0.2, 0.2, (128, 2))
     return contact, normal, action, mu, points, weights, rho, s, drift
 
 
@@ -205,10 +205,30 @@ def test_invariances(disc_pushes):
         _assert_close(padded.twist, base.twist, 1e-13, scale)
         np.testing.assert_allclose(padded.force, base.force, atol=1e-13)
         # s scales the twist only.
-        still = limit_surface.solve(contact, normal, action, mu, points, weights, rho, np.zeros(90), drift)
+        still = limit_surface.solve(contact, normal, action, mu, points, weights, rho, np.zeros(128), drift)
         assert np.all(np.asarray(still.twist) == 0)
         np.testing.assert_array_equal(still.force, base.force)
         assert np.all(np.asarray(base.twist)[np.sum(action * normal, -1) <= 0] == 0)
+
+
+def test_force_balances_the_friction_wrench(disc_pushes):
+    # Quasi-static equilibrium: the support's friction wrench grad D(V) at the predicted twist equals the pusher's
+    # wrench (force, c x force) plus the drift force, sticking or slipping.
+    contact, normal, action, mu, points, weights, rho, s, drift = disc_pushes
+    with jax.enable_x64(True):
+        solution = limit_surface.solve(*disc_pushes)
+        moving = np.asarray(solution.sticking | solution.slipping)
+        _, wrench = limit_surface.dissipation(solution.twist[moving], points, weights, rho)
+    force = np.asarray(solution.force)[moving]
+    np.testing.assert_allclose(wrench[:, :2], force + drift[moving], atol=1e-12)
+    torque = contact[moving, 0] * force[:, 1] - contact[moving, 1] * force[:, 0]
+    np.testing.assert_allclose(wrench[:, 2], torque, atol=1e-12)
+    # Slipping forces lie on the friction-cone edge.
+    slipping = np.asarray(solution.slipping)
+    unit = normal[slipping] / np.linalg.norm(normal[slipping], axis=-1, keepdims=True)
+    slip_force = np.asarray(solution.force)[slipping]
+    along, across = np.sum(unit * slip_force, -1), unit[:, 0] * slip_force[:, 1] - unit[:, 1] * slip_force[:, 0]
+    np.testing.assert_allclose(np.abs(across), mu[slipping] * along, rtol=1e-10)
 
 
 def test_vmap_and_batched_support_arrays(disc_pushes):
@@ -218,8 +238,8 @@ def test_vmap_and_batched_support_arrays(disc_pushes):
         mapped = jax.vmap(limit_surface.predict, in_axes=(0, 0, 0, 0, None, None, None, 0, 0))(*disc_pushes)
         np.testing.assert_allclose(mapped, batched, rtol=1e-12, atol=1e-15)
         # Per-push supports (here all the same) broadcast like the other arguments.
-        per_push = limit_surface.predict(contact, normal, action, mu, np.broadcast_to(points, (90, *points.shape)),
-                                         np.broadcast_to(weights, (90, len(weights))), np.full(90, rho), s, drift)
+        per_push = limit_surface.predict(contact, normal, action, mu, np.broadcast_to(points, (128, *points.shape)),
+                                         np.broadcast_to(weights, (128, len(weights))), np.full(128, rho), s, drift)
         np.testing.assert_allclose(per_push, batched, rtol=1e-12, atol=1e-15)
     with pytest.raises(ValueError, match="support_weights"):
         limit_surface.predict(contact, normal, action, mu, points, weights[:5], rho)
