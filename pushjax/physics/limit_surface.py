@@ -89,12 +89,17 @@ class Solution(NamedTuple):
         ``mu_s m g`` (independent of ``s`` and of the size of ``action``); zero where not pushing.
       sticking: [...] bool, the contact sticks (and the pusher pushes).
       slipping: [...] bool, the contact slips (and the pusher pushes with positive normal velocity).
+      residual: [...] optimality residual of the solve that gave the result, the largest gradient component of
+        its objective with the torque divided by the support's length scale ``l`` (units of ``mu_s m g``; 0
+        where not pushing; no derivative). About 1e-15 (float64) or 1e-7 (float32) when converged; a larger
+        value asks for more iterations (small patches, see :data:`ITERATIONS`).
     """
 
     twist: jax.Array
     force: jax.Array
     sticking: jax.Array
     slipping: jax.Array
+    residual: jax.Array
 
 
 def _check_shapes(arrays: dict) -> tuple[int, ...]:
@@ -292,7 +297,7 @@ def solve(contact, normal, action, mu, support_points, support_weights, patch_ra
       stick_iterations, slip_iterations: Newton iterations (static).
 
     Returns:
-      :class:`Solution` (twist [..., 3], force [..., 2], sticking [...], slipping [...]).
+      :class:`Solution` (twist [..., 3], force [..., 2], sticking [...], slipping [...], residual [...]).
     """
     contact, normal, action, mu, points, weights, rho, s = map(
         jnp.asarray, (contact, normal, action, mu, support_points, support_weights, patch_radius, s))
@@ -357,6 +362,8 @@ def solve(contact, normal, action, mu, support_points, support_weights, patch_ra
     z1, z2, z3, inverse = _patch_velocities(stick_problem, zero, t_stick)
     force_x = _sum(p * z1 * inverse) - gx
     force_y = _sum(p * z2 * inverse) - gy
+    rho_k = rho[..., None]
+    stick_torque = _sum(p * (-z1 * dy + z2 * dx + z3 * rho_k) * inverse) - beta_t  # d objective / dt
     inside = jnp.abs(nx * force_y - ny * force_x) <= mu * (nx * force_x + ny * force_y)
     sticking = pushing & inside
 
@@ -386,9 +393,10 @@ def solve(contact, normal, action, mu, support_points, support_weights, patch_ra
     slip_ax, slip_ay = a0x + sigma * ex, a0y + sigma * ey
     normal_velocity = slip_ax * nx + slip_ay * ny
     slipping = pushing & ~sticking & (normal_velocity > 0)
-    z1s, z2s, _, inverse_s = _patch_velocities(slip_problem, sigma, t_slip)
+    z1s, z2s, z3s, inverse_s = _patch_velocities(slip_problem, sigma, t_slip)
     slip_force_x = _sum(p * z1s * inverse_s) - gx
     slip_force_y = _sum(p * z2s * inverse_s) - gy
+    slip_torque = _sum(p * (-z1s * dy + z2s * dx + z3s * rho_k) * inverse_s) - beta_t
 
     # Twist: contact velocity a and rotation t give v = a - t k x c = a + t (c_y, -c_x).
     ratio = jnp.where(slipping, normal_push / jnp.where(slipping, normal_velocity, 1), 0)
@@ -402,7 +410,10 @@ def solve(contact, normal, action, mu, support_points, support_weights, patch_ra
         jnp.where(sticking, force_x, jnp.where(slipping, slip_force_x, 0)),
         jnp.where(sticking, force_y, jnp.where(slipping, slip_force_y, 0)),
     ], axis=-1)
-    return Solution(twist, force, sticking, slipping)
+    length = jnp.sqrt(l2)
+    residual = jnp.where(sticking, jnp.abs(stick_torque) / length, jnp.where(
+        slipping, jnp.maximum(jnp.abs(slip_force_x * ex + slip_force_y * ey), jnp.abs(slip_torque) / length), 0))
+    return Solution(twist, force, sticking, slipping, jax.lax.stop_gradient(residual))
 
 
 @functools.partial(jax.jit, static_argnames=("stick_iterations", "slip_iterations"))

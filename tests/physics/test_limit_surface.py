@@ -69,6 +69,7 @@ def test_matches_independent_scipy_reference(name):
         if mode != "none":
             np.testing.assert_allclose(solution.force[i], force, rtol=1e-6, atol=1e-8, err_msg=f"push {i}")
     modes = np.array(modes)
+    assert np.max(np.asarray(solution.residual)) < 1e-13  # converged within the default iterations
     np.testing.assert_array_equal(np.asarray(solution.sticking), modes == "stick")
     np.testing.assert_array_equal(np.asarray(solution.slipping), modes == "slip")
     pulling = np.sum(action * normal, -1) <= 0
@@ -255,6 +256,7 @@ def test_float32_agrees_with_float64(disc_pushes):
         double = limit_surface.solve(*disc_pushes)
     scale = np.linalg.norm(action, axis=-1, keepdims=True) * (1 + 1 / RADIUS)
     _assert_close(single.twist, double.twist, 1e-4, scale)
+    assert np.max(np.asarray(single.residual)) < 1e-5
     np.testing.assert_allclose(single.force, double.force, rtol=1e-4, atol=1e-4)
 
 
