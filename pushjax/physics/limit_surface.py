@@ -66,17 +66,24 @@ __all__ = ["ITERATIONS", "STEP_LIMIT", "Solution", "dissipation", "predict", "so
 ITERATIONS = {"stick": 7, "slip": 8}
 """Default Newton iterations of the sticking (1-D) and slipping (2-D) solves.
 
-Measured in float64 on 1000 random pushes per case (uniform disc grids of K = 24 and 64 points with random
-weights, contacts at 0.3-1.5 radii, mu in [0, 1.5], with and without a drift force of 0.36), largest relative
-twist error against 60 iterations: with the patch radius about half the grid spacing (rho ~ R / 10), the
-sticking solve reaches 1e-9 after 5 iterations and 1e-15 after 6, the slipping solve 1e-7 after 5 and 1e-13
-after 6 (float32's precision is reached one iteration earlier). Smaller patches sharpen the kinks and cost
-more: rho = R / 50 needs 8 (sticking) and 10 (slipping) iterations for 1e-15, and the defaults give about
-3e-8 and 1e-6 there; rho = R / 5000 needs about 24 and 40. Pass larger counts for small patches.
+Measured in float64 on 1000 random pushes per case (uniform disc grids of radius R with K = 24 and 64 points
+and random weights, contacts at 0.3-1.5 R, mu in [0, 1.5], with and without a drift force of 0.36), largest
+relative twist error against 60 iterations: with the patch radius about half the grid spacing (rho ~ R / 10),
+the sticking solve reaches 1e-9 after 5 iterations and 1e-15 after 6, the slipping solve 1e-7 after 5 and
+1e-13 after 6 (float32's precision one iteration earlier). Smaller patches sharpen the kinks and cost more:
+rho = R / 50 needs 8 (sticking) and 10 (slipping) iterations for 1e-15 (the defaults give about 1e-8 and
+1e-6 there), rho = R / 500 about 12. Pass larger counts for small patches; :attr:`Solution.residual` tells
+whether a solve converged.
 """
 
-STEP_LIMIT = 0.9
-"""Largest relative change ``|dz_k| / |z_k|`` of any patch velocity in one Newton step."""
+STEP_LIMIT = 0.99
+"""Largest relative change ``|dz_k| / |z_k|`` of any patch velocity in one Newton step.
+
+Just below 1: a step may then nearly reach a kink's centre (1 would land on it for a lone pseudo-Huber term)
+but never jump across it. On 500 random pushes with drift (K = 24), 12 iterations of both solves reach
+2e-16 / 6e-16 / 5e-16 for rho = R/5, R/50, R/500 with 0.99, against 4e-16 / 4e-16 / 3e-9 with 0.9,
+1e-11 / 5e-3 with 1.5 at the two small patches, and no convergence with 3.
+"""
 
 
 class Solution(NamedTuple):
