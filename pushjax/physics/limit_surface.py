@@ -28,6 +28,15 @@ A point pusher at ``c`` with inward normal ``n``, Coulomb coefficient ``mu`` and
   multiplier is ``nu = D - g . v > 0``); its length makes the contact's normal velocity equal the
   pusher's, and there is no motion if that normal velocity is not positive (as in ``lynch``).
 
+How it differs from Lynch's ellipsoid (tested in ``tests/physics/test_limit_surface.py``): the torque
+intercept (pure rotation about the supports' weighted geometric median, zero force) is
+``m_max = sum_k p_k sqrt(|r_k - median|^2 + rho^2)``, which is where the ellipsoid with ``l = m_max`` agrees;
+near pure translation along ``x`` the exact surface is the ellipsoid with ``l_eff^2 = Var(x_k) + rho^2`` (the
+supports' second moment along the motion), smaller: a uniform disc of radius R has
+``m_max = 2R/3`` but ``l_eff = R/2``, so a slightly off-centre push at the rim turns it about 16 % more than
+Lynch's model says. The stick/slip switch is continuous in the twist and the force, not in their derivatives.
+:func:`dissipation` evaluates ``D`` and the wrench for given twists.
+
 Both problems are written with the contact-point velocity ``a = a_0 + sigma e`` (``e`` a unit vector,
 ``sigma`` the tangential slip; ``a = u / |u|`` fixed when sticking) and the rotation rate ``t``, so that
 ``z_k = (a - t k x d_k, rho t)`` with ``d_k = r_k - c`` is the (3-vector) velocity of patch ``k`` and

@@ -170,7 +170,7 @@ def test_small_rotations_differ_from_lynch_by_the_second_moment():
     np.testing.assert_allclose(solution.twist[2], -delta / (l_eff2 + RADIUS**2), rtol=1e-4)
     ratio = float(solution.twist[2] / lynch_twist[2])
     np.testing.assert_allclose(ratio, (m_max**2 + RADIUS**2) / (l_eff2 + RADIUS**2), rtol=1e-4)
-    # For a uniform disc (m_max = 2R/3, Var x = R^2/4) the exact model turns 15 % more than Lynch's here.
+    # For a uniform disc (m_max = 2R/3, Var x = R^2/4) the exact model turns about 16 % more than Lynch's here.
     assert 1.12 < ratio < 1.18
 
 
