@@ -356,7 +356,8 @@ def solve(contact, normal, action, mu, support_points, support_weights, patch_ra
     # the effective l of small rotations.
     centroid_x, centroid_y = _sum(p * rx), _sum(p * ry)
     l2 = 0.5 * _sum(p * ((rx - centroid_x[..., None]) ** 2 + (ry - centroid_y[..., None]) ** 2)) + rho * rho
-    l2 = jax.lax.stop_gradient(l2)
+    # Positive also for the invalid rho = 0 with a single support (keeps the guesses finite there).
+    l2 = jax.lax.stop_gradient(jnp.maximum(l2, jnp.finfo(dtype).eps * (cx * cx + cy * cy + 1e-6)))
     ccx, ccy = cx - centroid_x, cy - centroid_y  # contact relative to the centroid
 
     dx, dy = rx - cx[..., None], ry - cy[..., None]
