@@ -215,7 +215,7 @@ def test_invariances(disc_pushes):
 def test_force_balances_the_friction_wrench(disc_pushes):
     # Quasi-static equilibrium: the support's friction wrench grad D(V) at the predicted twist equals the pusher's
     # wrench (force, c x force) plus the drift force, sticking or slipping.
-    contact, normal, action, mu, points, weights, rho, s, drift = disc_pushes
+    contact, normal, _, mu, points, weights, rho, _, drift = disc_pushes
     with jax.enable_x64(True):
         solution = limit_surface.solve(*disc_pushes)
         moving = np.asarray(solution.sticking | solution.slipping)
@@ -249,7 +249,7 @@ def test_vmap_and_batched_support_arrays(disc_pushes):
 
 
 def test_float32_agrees_with_float64(disc_pushes):
-    contact, normal, action, mu, points, weights, rho, s, drift = disc_pushes
+    action = disc_pushes[2]
     single = limit_surface.solve(*(np.asarray(x, np.float32) for x in disc_pushes))
     assert single.twist.dtype == jnp.float32
     with jax.enable_x64(True):
@@ -324,20 +324,20 @@ def test_gradients_match_central_differences():
 
 
 DEGENERATE = {
-    "no contact": dict(normal=[0.0, 0.0]),
-    "no action": dict(action=[0.0, 0.0]),
-    "pulling": dict(action=[-0.01, 0.0]),
-    "s = 0": dict(s=0.0),
-    "contact on a support point": dict(contact=[0.0, 0.0]),
-    "contact on the padding point": dict(contact=[0.01, 0.01]),
-    "frictionless": dict(mu=0.0),
-    "drift": dict(drift=[0.2, 0.1]),
+    "no contact": {"normal": [0.0, 0.0]},
+    "no action": {"action": [0.0, 0.0]},
+    "pulling": {"action": [-0.01, 0.0]},
+    "s = 0": {"s": 0.0},
+    "contact on a support point": {"contact": [0.0, 0.0]},
+    "contact on the padding point": {"contact": [0.01, 0.01]},
+    "frictionless": {"mu": 0.0},
+    "drift": {"drift": [0.2, 0.1]},
 }
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
 def test_gradients_are_finite_on_degenerate_pushes(dtype):
-    base = dict(contact=[-0.03, 0.01], normal=[1.0, 0.0], action=[0.01, 0.003], mu=0.3, s=1.0, drift=[0.0, 0.0])
+    base = {"contact": [-0.03, 0.01], "normal": [1.0, 0.0], "action": [0.01, 0.003], "mu": 0.3, "s": 1.0, "drift": [0.0, 0.0]}
     cases = [{**base, **change} for change in DEGENERATE.values()]
     points, weights, rho = SMALL_SUPPORT
     batch = [np.asarray([case[name] for case in cases], float) for name in ("contact", "normal", "action", "mu")]
