@@ -257,18 +257,12 @@ def _solve_x_jvp(two_d, iterations, primals, tangents):
     return x, step
 
 
-def _value(problem, sigma, t):
-    """f(x) + beta . x = D - g . v up to the constant g . a0 (unused by the solve; for tests)."""
-    z1, z2, z3, inverse = _patch_velocities(problem, sigma, t)
-    return _sum(problem.p * (z1 * z1 + z2 * z2 + z3 * z3) * inverse)
-
-
 # --------------------------------------------------------------------------------------------------
 # Public functions
 
 
 def dissipation(twist, support_points, support_weights, patch_radius):
-    """D(V) and its gradient, the friction wrench, for given twists (reference and tests).
+    """D(V) and its gradient, the friction wrench, for given twists (not jitted; V != 0, where D has its kink).
 
     Args:
       twist: [..., 3] (v_x, v_y, omega) of the frame origin.
