@@ -82,7 +82,8 @@ the sticking solve reaches 1e-9 after 5 iterations and 1e-15 after 6, the slippi
 1e-13 after 6 (float32's precision one iteration earlier). Smaller patches sharpen the kinks and cost more:
 rho = R / 50 needs 8 (sticking) and 10 (slipping) iterations for 1e-15 (the defaults give about 1e-8 and
 1e-6 there), rho = R / 500 about 12. Pass larger counts for small patches; :attr:`Solution.residual` tells
-whether a solve converged.
+whether a solve converged. In float32 with rho ~ R / 10, 5 / 6 iterations already agree with 40 to float32's
+precision (1e-7 of the twist on 10^4 pushes, K = 24), which saves about a third of the time.
 """
 
 STEP_LIMIT = 0.99
