@@ -1,5 +1,5 @@
-"""Analytical physics models: the differentiable Lynch quasi-static pushing model."""
+"""Analytical physics models: the differentiable Lynch quasi-static pushing model and the exact limit surface."""
 
-from pushjax.physics import effects, lynch
+from pushjax.physics import effects, limit_surface, lynch
 
-__all__ = ["effects", "lynch"]
+__all__ = ["effects", "limit_surface", "lynch"]
