@@ -175,7 +175,10 @@ def _residual_jacobian(scaled, mask, inputs, target, scales, exact):
         prediction = _FULL_MODELS[exact](_params_from_scaled(unravel(flat), mask, exact), inputs)
         return (prediction - target) / jnp.stack([scales[0], scales[0], scales[1]])
 
-    return residuals(flat), jax.jacfwd(residuals)(flat)
+    # One forward-mode derivative per variable in sequence: jax.jacfwd's vmap over the basis gives some of the exact
+    # limit surface's columns as zeros under jit (jax 0.10.2, XLA:CPU), one at a time is right.
+    columns = jax.lax.map(lambda basis: jax.jvp(residuals, (flat,), (basis,))[1], jnp.eye(len(flat), dtype=flat.dtype))
+    return residuals(flat), jnp.moveaxis(columns, 0, -1)
 
 
 @functools.partial(jax.jit, static_argnames="exact")
