@@ -21,6 +21,9 @@ def _random_pushes(obj, count, seed):
     return start, motion
 
 
+_batched = jax.jit(jax.vmap(outline_jax.first_contact, in_axes=(None, 0, 0)))
+
+
 @pytest.mark.parametrize("name", ["rect1", "tri2", "hex", "butter"])
 def test_first_contact_matches_numpy_annotation_on_polygons(name):
     obj = get_object(name)
@@ -28,7 +31,7 @@ def test_first_contact_matches_numpy_annotation_on_polygons(name):
     expected = contact_lib.annotate(obj, np.zeros(3), start, motion)
     with jax.enable_x64(True):
         shape = outline_jax.outline(obj, jnp.float64)
-        got = jax.vmap(outline_jax.first_contact, in_axes=(None, 0, 0))(shape, start, motion)
+        got = _batched(shape, start, motion)
         got = jax.tree_util.tree_map(np.asarray, got)
     np.testing.assert_array_equal(got.touches, expected.touches)
     touches = expected.touches
@@ -45,8 +48,7 @@ def test_ellipse_polygon_error_is_the_documented_one():
     sagitta = outline_jax.ellipse_sagitta(obj.semi_axes, 256)
     assert 5e-6 < sagitta < 6e-6  # the module docstring's 5.9 µm
     with jax.enable_x64(True):
-        got = jax.vmap(outline_jax.first_contact, in_axes=(None, 0, 0))(
-            outline_jax.outline(obj, jnp.float64), start, motion)
+        got = _batched(outline_jax.outline(obj, jnp.float64), start, motion)
     both = np.asarray(got.touches) & expected.touches
     # Touching differs only where the path grazes the outline within the sagitta.
     assert np.mean(np.asarray(got.touches) == expected.touches) > 0.98
@@ -55,32 +57,37 @@ def test_ellipse_polygon_error_is_the_documented_one():
                                                -1, 1)))) < 1.2  # half a facet's turn, 1.05°, plus the contacts' offset
 
 
-@pytest.mark.parametrize("pusher, motion", [
-    ([0.0, -0.045 - PUSHER_RADIUS], [0.0, 0.0]),          # no motion, touching exactly
-    ([0.0, -0.045 - PUSHER_RADIUS], [0.01, 0.0]),         # sliding along the edge, parallel to it
-    ([0.0, 0.0], [0.01, 0.002]),                          # centre inside the object
-    ([0.0, -0.045], [0.0, 0.01]),                          # centre on the outline
-    ([0.2, 0.2], [0.01, 0.0]),                             # far away, never touching
+DEGENERATE = [
+    ([0.0, -0.045 - PUSHER_RADIUS], [0.0, 0.0]),            # no motion, touching exactly
+    ([0.0, -0.045 - PUSHER_RADIUS], [0.01, 0.0]),           # sliding along the edge, parallel to it
+    ([0.0, 0.0], [0.01, 0.002]),                            # centre inside the object
+    ([0.0, -0.045], [0.0, 0.01]),                           # centre on the outline
+    ([0.2, 0.2], [0.01, 0.0]),                              # far away, never touching
     ([0.045 + PUSHER_RADIUS, 0.045 + 0.01], [0.0, -0.02]),  # onto the corner circle's tangent point
-    ([-0.045, -0.06], [0.0, 0.02]),                        # exactly at a vertex's x
-])
-def test_gradients_are_finite_on_degenerate_pushes(pusher, motion):
+    ([-0.045, -0.06], [0.0, 0.02]),                         # exactly at a vertex's x
+    ([0.0, -0.06], [0.0, 0.0]),                             # no motion, not touching
+]
+
+
+def test_gradients_are_finite_on_degenerate_pushes():
     shape = outline_jax.outline("rect1")
 
     def total(pusher, motion):
         hit = outline_jax.first_contact(shape, pusher, motion)
         return jnp.sum(hit.point) + jnp.sum(hit.normal) + hit.fraction + hit.gap
 
-    grads = jax.grad(total, argnums=(0, 1))(jnp.asarray(pusher), jnp.asarray(motion))
-    assert all(np.all(np.isfinite(g)) for g in grads)
+    pushers, motions = (jnp.asarray(np.array(values, np.float32)) for values in zip(*DEGENERATE))
+    grads = jax.jit(jax.vmap(jax.grad(total, argnums=(0, 1))))(pushers, motions)
+    for grad in grads:
+        assert np.all(np.isfinite(np.asarray(grad)))
 
 
 def test_vertex_normal_turns_with_the_pusher():
     """At a corner the normal is that of the corner circle: continuous as the pusher passes the corner."""
     shape = outline_jax.outline("rect1")
     offsets = np.linspace(-0.004, 0.002, 13)
-    normals = [np.asarray(outline_jax.first_contact(
-        shape, jnp.array([0.045 + PUSHER_RADIUS * 0.5 + x, -0.07]), jnp.array([0.0, 0.05])).normal) for x in offsets]
+    pushers = np.stack([0.045 + PUSHER_RADIUS * 0.5 + offsets, np.full_like(offsets, -0.07)], axis=-1)
+    normals = np.asarray(_batched(shape, pushers, np.tile([0.0, 0.05], (len(offsets), 1))).normal)
     turns = [np.degrees(np.arccos(np.clip(a @ b, -1, 1))) for a, b in zip(normals, normals[1:])]
     assert max(turns) < 40.0
     assert np.allclose(normals[0], [0, 1]) and not np.allclose(normals[-1], [0, 1])
