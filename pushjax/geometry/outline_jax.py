@@ -20,11 +20,13 @@ off the true normal by up to half a facet's turn (0.7° for ellip1 to 1.05° for
 first shrinks with the square, the second with the inverse of the vertex count. The contact normal still
 turns continuously as the pusher passes a vertex, whose circle feature turns the normal with the pusher.
 
-Everything is per push (one pusher, one motion): ``jax.vmap`` for batches. Minima over features select one
-feature with ``argmin`` and gather; every per-feature quantity is finite (double ``where``), so the
-gradients are finite everywhere, including pushes parallel to an edge, a zero motion and a pusher centre
-exactly on the outline. Derivatives are those of the selected feature: exact wherever the contact feature
-(and whether it is touching at the start) does not change under a small perturbation.
+Everything is per push (one pusher, one motion): ``jax.vmap`` for batches. The features (the nearest edge, the
+first one hit) are chosen over all of them without derivatives (``argmin``, a branch choice); the chosen
+features' quantities are then computed again from their own vertices, so derivatives cost O(1), not O(V), per
+contact. Every quantity is finite (double ``where``), so the gradients are finite everywhere, including pushes
+parallel to an edge, a zero motion and a pusher centre exactly on the outline. Derivatives are those of the
+chosen feature: exact wherever the contact feature (and whether it is touching at the start) does not change
+under a small perturbation.
 """
 
 from __future__ import annotations
@@ -184,57 +186,31 @@ def first_contact(shape: Outline, pusher, motion, radius=PUSHER_RADIUS) -> Conta
     if pusher.shape != (2,) or motion.shape != (2,):
         raise ValueError(f"pusher, motion: expected shape [2] each (vmap for batches), got {pusher.shape}, "
                          f"{motion.shape}")
+    r = jnp.asarray(radius, shape.start.dtype)
+    # Which features: decided over all of them without derivatives (a branch choice), then the chosen features'
+    # quantities are computed again from their vertices alone, so derivatives cost O(1) instead of O(V).
+    fixed = jax.lax.stop_gradient((shape, pusher, motion, r))
+    nearest_index, inside, touching_at_start, feature, is_edge, t_hit = _select(*fixed)
     a, e, out = shape.start, shape.edge, shape.outward
-    r = jnp.asarray(radius, a.dtype)
-    # Closest outline point to the start.
-    along = jnp.clip(_dot(pusher - a, e) / _dot(e, e), 0.0, 1.0)
-    closest = a + along[:, None] * e
-    offsets = pusher - closest
-    nearest_index = jnp.argmin(_dot(offsets, offsets))
-    nearest = closest[nearest_index]
-    distance = _safe_sqrt(_dot(offsets[nearest_index], offsets[nearest_index]))
-    inside = _inside(shape, pusher)
-    touching_at_start = inside | (distance <= r + _DISTANCE_TOLERANCE)
-    start_normal = _unit_or(jnp.where(inside, pusher - nearest, nearest - pusher), -out[nearest_index])
+
+    closest, offset = _closest_on_edges(a[nearest_index], e[nearest_index], pusher)
+    distance = _safe_sqrt(_dot(offset, offset))
+    start_normal = _unit_or(jnp.where(inside, pusher - closest, closest - pusher), -out[nearest_index])
     start_gap = jnp.where(inside, -distance - r, distance - r)
 
-    # Path against the edges offset outward by r: p + t u = a + r out + s e.
-    offset_start = a + r * out - pusher
-    denominator = _cross(motion, e)
-    parallel = denominator == 0
-    safe_denominator = jnp.where(parallel, 1.0, denominator)
-    t_edge = _cross(offset_start, e) / safe_denominator
-    s_edge = _cross(offset_start, motion) / safe_denominator
-    edge_hit = ~parallel & (s_edge >= 0) & (s_edge <= 1) & (t_edge >= -_TIME_TOLERANCE)
-    t_edge = jnp.where(edge_hit, jnp.maximum(t_edge, 0.0), NO_HIT)
-    # Path against the circles about the vertices: first root of |p - a + t u|^2 = r^2, written as
-    # c / (-b + sqrt(b^2 - a c)) to avoid cancellation.
-    relative = pusher - a
-    half_b = _dot(motion, relative)
-    c = _dot(relative, relative) - r * r
-    discriminant = half_b * half_b - _dot(motion, motion) * c
-    corner_hit = (half_b < 0) & (discriminant >= 0)
-    root_denominator = -half_b + _safe_sqrt(discriminant)
-    t_corner = c / jnp.where(corner_hit, root_denominator, 1.0)
-    corner_hit = corner_hit & (t_corner >= -_TIME_TOLERANCE)
-    t_corner = jnp.where(corner_hit, jnp.maximum(t_corner, 0.0), NO_HIT)
-
-    times = jnp.concatenate([t_edge, t_corner])
-    index = jnp.argmin(times)
-    count = a.shape[0]
-    feature = index % count
-    is_edge = index < count
-    t_hit = times[index]
-    hit_point = jnp.where(is_edge, a[feature] + jnp.clip(s_edge[feature], 0.0, 1.0) * e[feature], a[feature])
-    centre_at_hit = pusher + jnp.minimum(t_hit, 1.0) * motion
+    t_edge, s_edge = _edge_times(a[feature], e[feature], out[feature], pusher, motion, r)
+    t_corner = _corner_times(a[feature], pusher, motion, r)
+    t_value = jnp.where(t_hit < NO_HIT, jnp.where(is_edge, t_edge, t_corner), NO_HIT)
+    hit_point = jnp.where(is_edge, a[feature] + jnp.clip(s_edge, 0.0, 1.0) * e[feature], a[feature])
+    centre_at_hit = pusher + jnp.minimum(t_value, 1.0) * motion
     hit_normal = jnp.where(is_edge, -out[feature], _unit_or(a[feature] - centre_at_hit, -out[feature]))
 
     touches = touching_at_start | (t_hit <= 1.0)
     reachable = touching_at_start | (t_hit < NO_HIT)
-    fraction = jnp.where(touching_at_start, 0.0, jnp.where(touches, t_hit, 1.0))
-    point = jnp.where(touching_at_start, nearest, hit_point)
+    fraction = jnp.where(touching_at_start, 0.0, jnp.where(touches, t_value, 1.0))
+    point = jnp.where(touching_at_start, closest, hit_point)
     normal = jnp.where(touching_at_start, start_normal, hit_normal)
-    gap = jnp.where(touching_at_start, start_gap, t_hit * _dot(motion, hit_normal))
+    gap = jnp.where(touching_at_start, start_gap, t_value * _dot(motion, hit_normal))
     return Contact(
         touches=touches,
         fraction=fraction,
@@ -244,3 +220,53 @@ def first_contact(shape: Outline, pusher, motion, radius=PUSHER_RADIUS) -> Conta
         touching_at_start=touching_at_start,
         reachable=reachable,
     )
+
+
+def _closest_on_edges(a, e, pusher):
+    """Closest points [..., 2] of edges (start `a`, vector `e`) to `pusher`, and pusher minus them."""
+    along = jnp.clip(_dot(pusher - a, e) / _dot(e, e), 0.0, 1.0)
+    closest = a + along[..., None] * e
+    return closest, pusher - closest
+
+
+def _edge_times(a, e, out, pusher, motion, r):
+    """Hit time of the path with each edge offset outward by r (p + t u = a + r out + s e), NO_HIT where it
+    misses, and s."""
+    offset_start = a + r * out - pusher
+    denominator = _cross(motion, e)
+    parallel = denominator == 0
+    safe_denominator = jnp.where(parallel, 1.0, denominator)
+    t_edge = _cross(offset_start, e) / safe_denominator
+    s_edge = _cross(offset_start, motion) / safe_denominator
+    edge_hit = ~parallel & (s_edge >= 0) & (s_edge <= 1) & (t_edge >= -_TIME_TOLERANCE)
+    return jnp.where(edge_hit, jnp.maximum(t_edge, 0.0), NO_HIT), s_edge
+
+
+def _corner_times(a, pusher, motion, r):
+    """Hit time of the path with the circles of radius r about vertices `a`, NO_HIT where it misses: the first root
+    of |p - a + t u|^2 = r^2, written as c / (-b + sqrt(b^2 - a c)) to avoid cancellation."""
+    relative = pusher - a
+    half_b = _dot(motion, relative)
+    c = _dot(relative, relative) - r * r
+    discriminant = half_b * half_b - _dot(motion, motion) * c
+    corner_hit = (half_b < 0) & (discriminant >= 0)
+    root_denominator = -half_b + _safe_sqrt(discriminant)
+    t_corner = c / jnp.where(corner_hit, root_denominator, 1.0)
+    corner_hit = corner_hit & (t_corner >= -_TIME_TOLERANCE)
+    return jnp.where(corner_hit, jnp.maximum(t_corner, 0.0), NO_HIT)
+
+
+def _select(shape: Outline, pusher, motion, r):
+    """The features (no derivatives): nearest edge to the start, whether the start is inside and touching, the
+    first-hit feature's index, whether it is an edge (else the circle about its start vertex) and its hit time."""
+    a, e, out = shape.start, shape.edge, shape.outward
+    _, offsets = _closest_on_edges(a, e, pusher)
+    squared = _dot(offsets, offsets)
+    nearest_index = jnp.argmin(squared)
+    inside = _inside(shape, pusher)
+    touching_at_start = inside | (_safe_sqrt(squared[nearest_index]) <= r + _DISTANCE_TOLERANCE)
+    t_edge, _ = _edge_times(a, e, out, pusher, motion, r)
+    times = jnp.concatenate([t_edge, _corner_times(a, pusher, motion, r)])
+    index = jnp.argmin(times)
+    count = a.shape[0]
+    return nearest_index, inside, touching_at_start, index % count, index < count, times[index]
