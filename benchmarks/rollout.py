@@ -92,30 +92,34 @@ def main(argv):
     print("| object | pass | first call (s) | time (s) | rollouts/s | steps/s |")
     print("|---|---|---:|---:|---:|---:|")
     for name in _OBJECTS.value:
-        obj = get_object(name)
-        paths, mus = random_pushes(obj, count, steps, _SEED.value)
-        shape = outline_jax.outline(obj)
-        l = jnp.full(count, limit_surface_ratio(obj), jnp.float32)
-        paths_j, mus_j = jnp.asarray(paths, jnp.float32), jnp.asarray(mus, jnp.float32)
-        poses0 = jnp.zeros((count, 3))
+        _measure(name, count, steps, reference)
 
-        def final(path, pose, l, mu):
-            return rollout.rollout(shape, pose, path, l, mu).poses[-1]
 
-        forward = jax.jit(jax.vmap(final))
-        gradient = jax.jit(jax.vmap(jax.grad(lambda *args: jnp.sum(final(*args)), argnums=(0, 2, 3))))
-        for label, function in [("forward", lambda: forward(paths_j, poses0, l, mus_j)),
-                                ("grad w.r.t. path, l, mu", lambda: gradient(paths_j, poses0, l, mus_j))]:
-            first, median, best = _time(function, _REPEATS.value)
-            print(f"| {name} | {label} | {first:.1f} | {median:.3f} ({best:.3f}) | {count / median:,.0f} "
-                  f"({count / best:,.0f}) | {count * steps / median:,.0f} |")
-        numpy_count = min(_NUMPY_PUSHES.value, count)
-        start = time.perf_counter()
-        numpy_rollouts(obj, paths[:numpy_count], limit_surface_ratio(obj), mus[:numpy_count], reference)
-        elapsed = time.perf_counter() - start
-        print(f"| {name} | NumPy loop, float64 ({numpy_count} pushes) | | {elapsed:.3f} | {numpy_count / elapsed:,.0f} "
-              f"| {numpy_count * steps / elapsed:,.0f} |")
+def _measure(name, count, steps, reference):
+    """Prints the rows of one object."""
+    obj = get_object(name)
+    paths, mus = random_pushes(obj, count, steps, _SEED.value)
+    shape = outline_jax.outline(obj)
+    l = jnp.full(count, limit_surface_ratio(obj), jnp.float32)
+    paths_j, mus_j = jnp.asarray(paths, jnp.float32), jnp.asarray(mus, jnp.float32)
+    poses0 = jnp.zeros((count, 3))
 
+    def final(path, pose, l, mu):
+        return rollout.rollout(shape, pose, path, l, mu).poses[-1]
+
+    forward = jax.jit(jax.vmap(final))
+    gradient = jax.jit(jax.vmap(jax.grad(lambda *args: jnp.sum(final(*args)), argnums=(0, 2, 3))))
+    for label, function in [("forward", lambda: forward(paths_j, poses0, l, mus_j)),
+                            ("grad w.r.t. path, l, mu", lambda: gradient(paths_j, poses0, l, mus_j))]:
+        first, median, best = _time(function, _REPEATS.value)
+        print(f"| {name} | {label} | {first:.1f} | {median:.3f} ({best:.3f}) | {count / median:,.0f} "
+              f"({count / best:,.0f}) | {count * steps / median:,.0f} |")
+    numpy_count = min(_NUMPY_PUSHES.value, count)
+    start = time.perf_counter()
+    numpy_rollouts(obj, paths[:numpy_count], limit_surface_ratio(obj), mus[:numpy_count], reference)
+    elapsed = time.perf_counter() - start
+    print(f"| {name} | NumPy loop, float64 ({numpy_count} pushes) | | {elapsed:.3f} | {numpy_count / elapsed:,.0f} "
+          f"| {numpy_count * steps / elapsed:,.0f} |")
 
 if __name__ == "__main__":
     app.run(main)

@@ -27,16 +27,15 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import jax
-import jax.numpy as jnp
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from pushjax.filter import constant_velocity, ekf, metrics, models, particle, ukf  # noqa: E402
-from pushjax.sim import dataset  # noqa: E402
-from pushjax.sim.testbed import Testbed  # noqa: E402
+from pushjax.filter import constant_velocity, ekf, metrics, models, particle, ukf
+from pushjax.sim import dataset
+from pushjax.sim.testbed import Testbed
 
 __all__ = ["FILTERS", "SCALES", "TrackedPush", "run", "simulate_pushes", "write"]
 
@@ -98,7 +97,7 @@ def simulate_pushes(objects: Sequence[str], pushes: int, seed: int, testbed: Tes
     step = RECORDING_RATE_HZ / rate_hz
     if not (step >= 1 and abs(step - round(step)) < 1e-9):
         raise ValueError(f"rate_hz: expected {RECORDING_RATE_HZ} Hz divided by a whole number, got {rate_hz}")
-    step = int(round(step))
+    step = round(step)
     jobs = dataset.plan_pushes("unused", list(objects), ["abs"], pushes, seed=seed, velocities=[velocity],
                                testbed=testbed)
     result = []
@@ -226,8 +225,8 @@ def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, parti
 
 
 def _table(results: dict) -> str:
-    lines = ["| estimate | position RMSE (mm) | yaw RMSE (deg) | NEES in 95 % band | mean NEES | mu: mean abs log error, "
-             "prior → final | mu: posterior std / prior std |", "|---|---:|---:|---:|---:|---:|---:|"]
+    lines = [("| estimate | position RMSE (mm) | yaw RMSE (deg) | NEES in 95 % band | mean NEES | mu: mean abs log "
+              "error, prior → final | mu: posterior std / prior std |"), "|---|---:|---:|---:|---:|---:|---:|"]
     for name, entry in results["summary"].items():
         band = f"{entry['nees_in_95_band']:.2f}" if "nees_in_95_band" in entry else ""
         nees = f"{entry['nees_mean']:.2f}" if "nees_mean" in entry else ""
@@ -236,9 +235,8 @@ def _table(results: dict) -> str:
         spread = f"{entry['mu_final_std_log_over_prior']:.2f}" if "mu_final_std_log_over_prior" in entry else ""
         lines.append(f"| {name} | {entry['position_rmse_mm']:.3f} | {entry['yaw_rmse_deg']:.3f} | {band} | {nees} "
                      f"| {mu} | {spread} |")
-    lines += ["", "| push | mu true (nominal) | " + " | ".join(f"{f}: final mu ± std(log), within 20 % after"
-                                                               for f in results["filters"]) + " |",
-              "|---|---:|" + "---:|" * len(results["filters"])]
+    header = " | ".join(f"{f}: final mu ± std(log), within 20 % after" for f in results["filters"])
+    lines += ["", f"| push | mu true (nominal) | {header} |", "|---|---:|" + "---:|" * len(results["filters"])]
     for row in results["pushes"]:
         cells = []
         for name in results["filters"]:

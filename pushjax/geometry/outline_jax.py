@@ -41,7 +41,7 @@ import shapely
 
 from pushjax.geometry.objects import PUSHER_RADIUS, PushObject, get_object
 
-__all__ = ["Contact", "NO_HIT", "Outline", "ellipse_sagitta", "first_contact", "outline"]
+__all__ = ["NO_HIT", "Contact", "Outline", "ellipse_sagitta", "first_contact", "outline"]
 
 NO_HIT = 2.0
 """Hit time of a feature that the path never reaches (any value > 1 works; finite, unlike inf, so that

@@ -4,7 +4,6 @@ samples: tracking beats the raw measurements, NEES inside its chi-square band, m
 import functools
 
 import jax
-import jax.numpy as jnp
 import numpy as np
 import pytest
 

@@ -19,7 +19,7 @@ def test_smoke_run_writes_the_tables_and_the_figure(tmp_path):
     result = subprocess.run(
         [sys.executable, "-m", "experiments.track", "--scale=smoke", f"--workdir={tmp_path}",
          "--testbed_overrides=drop_rate=0.2"],
-        cwd=REPOSITORY, env={**os.environ, "MUJOCO_GL": "egl"}, capture_output=True, text=True, timeout=600)
+        cwd=REPOSITORY, env={**os.environ, "MUJOCO_GL": "egl"}, capture_output=True, text=True, timeout=600, check=False)
     assert result.returncode == 0, result.stderr[-3000:]
     assert f"wrote {tmp_path / 'results.json'}" in result.stdout
     results = json.loads((tmp_path / "results.json").read_text())

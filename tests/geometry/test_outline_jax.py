@@ -1,5 +1,7 @@
 """The JAX first contact against the NumPy contact annotation, and its gradients on degenerate pushes."""
 
+import itertools
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -88,6 +90,6 @@ def test_vertex_normal_turns_with_the_pusher():
     offsets = np.linspace(-0.004, 0.002, 13)
     pushers = np.stack([0.045 + PUSHER_RADIUS * 0.5 + offsets, np.full_like(offsets, -0.07)], axis=-1)
     normals = np.asarray(_batched(shape, pushers, np.tile([0.0, 0.05], (len(offsets), 1))).normal)
-    turns = [np.degrees(np.arccos(np.clip(a @ b, -1, 1))) for a, b in zip(normals, normals[1:])]
+    turns = [np.degrees(np.arccos(np.clip(a @ b, -1, 1))) for a, b in itertools.pairwise(normals)]
     assert max(turns) < 40.0
     assert np.allclose(normals[0], [0, 1]) and not np.allclose(normals[-1], [0, 1])

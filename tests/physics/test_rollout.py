@@ -1,6 +1,8 @@
 """The JAX rollout: agreement with an independent NumPy rollout, gradients against finite differences, contact
 lost and regained, effects, vmap."""
 
+import itertools
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -20,7 +22,7 @@ def _numpy_rollout(obj, pose, pusher_path, l, mu):
     """The former NumPy rollout, written with the NumPy contact annotation and the NumPy Lynch reference."""
     pose = np.asarray(pose, np.float64).copy()
     poses = [pose.copy()]
-    for start, end in zip(pusher_path[:-1], pusher_path[1:]):
+    for start, end in itertools.pairwise(pusher_path):
         state = contact_lib.annotate(obj, pose, start, end - start)
         motion = numpy_lynch.predict(state.contact_rel_com, state.normal, state.action_from_contact, l, mu)
         com_offset = planar.rotate(obj.centroid, pose[2])
@@ -117,7 +119,7 @@ def test_gradients_match_central_finite_differences(name, angle, mu):
         np.testing.assert_allclose(jacobian[2], central(lambda d: (path, l, mu + d, params)), rtol=1e-5, atol=1e-7)
         for index in [(3, 0), (12, 1), (STEPS, 0)]:
             np.testing.assert_allclose(jacobian[0][(slice(None), *index)],
-                                       central(lambda d: (path.at[index].add(d), l, mu, params)),
+                                       central(lambda d, index=index: (path.at[index].add(d), l, mu, params)),
                                        rtol=1e-5, atol=1e-7)
         for effect, name_ in [("cof_offset", "offset"), ("pusher_friction", "log_scale"),
                               ("friction_field", "gradient"), ("frame_offset", "offset")]:
