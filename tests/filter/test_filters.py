@@ -104,7 +104,7 @@ def test_a_dropped_sample_is_skipped_not_read_as_zero():
     with_zero = jax.tree_util.tree_map(np.asarray, ekf.filter_pushes(system, mean, cov, paths, zero))
     assert not with_nan.observed[push, k] and with_zero.observed[push, k]
     # Skipped: the belief at k is the prediction from k - 1.
-    predicted_mean, predicted_cov = ekf.predict(system, with_nan.mean[push, k - 1], with_nan.cov[push, k - 1],
+    predicted_mean, predicted_cov = jax.jit(ekf.predict)(system, with_nan.mean[push, k - 1], with_nan.cov[push, k - 1],
                                                 paths[push, k - 1], paths[push, k] - paths[push, k - 1])
     np.testing.assert_allclose(with_nan.mean[push, k], predicted_mean, rtol=1e-5, atol=1e-7)
     np.testing.assert_allclose(with_nan.cov[push, k], predicted_cov, rtol=1e-4, atol=1e-12)
