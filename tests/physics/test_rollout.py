@@ -93,7 +93,7 @@ def _effect_params(scale=1.0):
                                "curvature": scale * jnp.array([5.0, 1.0, -3.0])}}
 
 
-@pytest.mark.parametrize("name, angle, mu", [("rect1", 20.0, 0.25), ("butter", 25.0, 0.2)])
+@pytest.mark.parametrize("name, angle, mu", [("butter", 25.0, 0.2)])  # non-convex, slips: mu matters
 def test_gradients_match_central_finite_differences(name, angle, mu):
     """Final pose w.r.t. the pusher path, l, mu and the effects' parameters, on pushes that keep their side."""
     obj = get_object(name)
@@ -131,7 +131,7 @@ def test_gradients_match_central_finite_differences(name, angle, mu):
 
             np.testing.assert_allclose(jnp.tensordot(jacobian[3][effect][name_], unit, unit.ndim),
                                        central(shifted), rtol=1e-5, atol=1e-7)
-        assert np.abs(jacobian[2]).max() > 0 or name == "rect1"  # butter's push slips: mu matters
+        assert np.abs(jacobian[2]).max() > 0  # the push slips: mu matters
 
 
 def _lost_and_regained_path():
