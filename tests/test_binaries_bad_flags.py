@@ -200,6 +200,16 @@ CASES = [
     ("findings", ["--workdirs={empty}", "--output={file}/table.md"], "--output"),
     ("findings", ["--workdirs={empty}", "--output={read_only}/table.md"], "--output"),
     ("findings", ["--workdirs={empty}", "extra"], "unexpected arguments"),
+    # track
+    ("track", [], "--workdir"),
+    ("track", ["--workdir={file}/track"], "--workdir"),
+    ("track", ["--workdir={read_only}/track"], "--workdir"),
+    *[("track", ["--workdir={tmp}/track", f"--{flag}={value}"], f"--{flag}")
+      for flag, values in (("scale", ("paper", "huge")), ("filters", ("kalman", "ekf,ekf", "")),
+                           ("seed", ("-1",)), ("rate_hz", ("0", "7", "nan", "500")),
+                           ("testbed", ("perfect",)), ("testbed_overrides", ("drop_rate=2", "wind=1")))
+      for value in values],
+    ("track", ["--workdir={tmp}/track", "extra"], "unexpected arguments"),
     # demo
     *[("demo", [f"--{flag}={value}"], f"--{flag}")
       for flag, values in (("mu", ("-1", "nan", "inf")), ("angle_deg", ("90", "-120", "nan")),

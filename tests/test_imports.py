@@ -41,7 +41,7 @@ LAYERS = {
     "pushjax.geometry": 1, "pushjax.render.camera": 1,
     "pushjax.physics": 2, "pushjax.mit": 2,
     "pushjax.sim": 3, "pushjax.render": 3, "pushjax.render.renderer": 3,
-    "pushjax.data": 4, "pushjax.models": 4,
+    "pushjax.data": 4, "pushjax.models": 4, "pushjax.filter": 4,
     "pushjax.train": 5,
     "pushjax.paper": 6, "pushjax.loop": 6,
 }

@@ -1,5 +1,5 @@
-"""Analytical physics models: the differentiable Lynch quasi-static pushing model and the exact limit surface."""
+"""Analytical physics models: the differentiable Lynch quasi-static pushing model, the exact limit surface, rollouts."""
 
-from pushjax.physics import effects, limit_surface, lynch
+from pushjax.physics import effects, limit_surface, lynch, rollout
 
-__all__ = ["effects", "limit_surface", "lynch"]
+__all__ = ["effects", "limit_surface", "lynch", "rollout"]

@@ -6,7 +6,7 @@ import numpy as np
 
 from pushjax import planar
 from pushjax.geometry.objects import PUSHER_RADIUS, all_objects, limit_surface_ratio
-from pushjax.physics.rollout import rollout
+from pushjax.physics.rollout import straight_push
 
 PUSH_DISTANCE = 0.05
 
@@ -31,7 +31,7 @@ def analytical_push_table(mu: float = 0.25, angle_deg: float = 20.0, point: floa
         surface_point, normal = obj.side_point(0, point)
         direction = planar.rotation_matrix(angle) @ normal
         pusher_start = surface_point - direction * (PUSHER_RADIUS / max(direction @ normal, 1e-6) + 1e-3)
-        poses = rollout(obj, np.zeros(3), pusher_start, PUSH_DISTANCE * direction, mu, steps=steps)
+        poses = straight_push(obj, np.zeros(3), pusher_start, PUSH_DISTANCE * direction, mu, steps=steps)
         dx, dy, dtheta = poses[-1] - poses[0]
         l = limit_surface_ratio(obj)
         rows.append(f"| {obj.name} | {l * 1e3:.1f} | {dx * 1e3:.1f} | {dy * 1e3:.1f} | {np.rad2deg(dtheta):.1f} |")

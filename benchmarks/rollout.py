@@ -1,0 +1,125 @@
+"""Throughput of the JAX rollout (``pushjax.physics.rollout.rollout``) on CPU, against a vectorised NumPy loop.
+
+A batch of ``--pushes`` straight pushes of 5 cm in ``--steps`` steps per object (random side, point along it,
+angle within ±40° of the side's normal, mu in [0.1, 1]), ``jax.vmap`` over the batch under ``jax.jit``:
+rollouts per second of the forward pass, and of ``jax.grad`` of the summed final poses with respect to the
+pusher paths, l and mu. The NumPy baseline runs the same steps vectorised over the batch (the NumPy contact
+annotation ``pushjax.geometry.contact.annotate`` and the NumPy reference model of the tests), float64, on
+``--numpy_pushes`` pushes. Prints a markdown table.
+
+    python benchmarks/rollout.py [--pushes=1000] [--steps=100] [--objects=rect1,ellip2,butter] [--repeats=5]
+
+Times are the median (and best) over ``--repeats`` calls after a warm-up (compiling) call, with
+``block_until_ready``; the compile time of the first call is given separately.
+"""
+
+import importlib.util
+import pathlib
+import platform
+import time
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from absl import app, flags
+
+from pushjax import planar
+from pushjax.geometry import contact as contact_lib
+from pushjax.geometry import outline_jax
+from pushjax.geometry.objects import PUSHER_RADIUS, get_object, limit_surface_ratio
+from pushjax.physics import rollout
+
+_PUSHES = flags.DEFINE_integer("pushes", 1000, "Pushes per batch.")
+_STEPS = flags.DEFINE_integer("steps", 100, "Steps per push.")
+_OBJECTS = flags.DEFINE_list("objects", ["rect1", "ellip2", "butter"], "Objects to measure.")
+_REPEATS = flags.DEFINE_integer("repeats", 5, "Timed calls per measurement.")
+_NUMPY_PUSHES = flags.DEFINE_integer("numpy_pushes", 1000, "Pushes of the NumPy baseline's batch.")
+_SEED = flags.DEFINE_integer("seed", 0, "Seed of the random pushes.")
+
+_REFERENCE_PATH = pathlib.Path(__file__).resolve().parents[1] / "tests" / "physics" / "numpy_lynch.py"
+
+
+def _load_numpy_reference():
+    spec = importlib.util.spec_from_file_location("numpy_lynch", _REFERENCE_PATH)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def random_pushes(obj, count, steps, seed):
+    """([count, steps + 1, 2] pusher paths, [count] mu), pushes of 5 cm into random sides of `obj` at yaw 0."""
+    rng = np.random.default_rng(seed)
+    paths = np.empty((count, steps + 1, 2))
+    for k in range(count):
+        point, normal = obj.side_point(int(rng.integers(len(obj.sides))), float(rng.uniform(0.1, 0.9)))
+        direction = planar.rotation_matrix(rng.uniform(-0.7, 0.7)) @ normal
+        start = point - direction * (PUSHER_RADIUS / (direction @ normal) + 1e-3)
+        paths[k] = start + np.linspace(0.0, 1.0, steps + 1)[:, None] * 0.05 * direction
+    return paths, rng.uniform(0.1, 1.0, count)
+
+
+def numpy_rollouts(obj, paths, l, mu, reference):
+    """[N, 3] final poses of the NumPy loop, vectorised over the pushes."""
+    pose = np.zeros((len(paths), 3))
+    for k in range(paths.shape[1] - 1):
+        state = contact_lib.annotate(obj, pose, paths[:, k], paths[:, k + 1] - paths[:, k])
+        motion = reference.predict(state.contact_rel_com, state.normal, state.action_from_contact, l, mu)
+        com_offset = planar.rotate(np.broadcast_to(obj.centroid, (len(pose), 2)), pose[:, 2])
+        com = pose[:, :2] + com_offset + motion[:, :2]
+        pose = np.concatenate([com - planar.rotate(com_offset, motion[:, 2]), (pose[:, 2] + motion[:, 2])[:, None]],
+                              axis=-1)
+    return pose
+
+
+def _time(function, repeats):
+    start = time.perf_counter()
+    jax.block_until_ready(function())
+    first = time.perf_counter() - start
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        jax.block_until_ready(function())
+        times.append(time.perf_counter() - start)
+    return first, float(np.median(times)), float(np.min(times))
+
+
+def main(argv):
+    del argv
+    reference = _load_numpy_reference()
+    count, steps = _PUSHES.value, _STEPS.value
+    print(f"{platform.processor() or platform.machine()}, {jax.devices()[0].platform}, jax {jax.__version__}; "
+          f"{count} pushes x {steps} steps, float32, median (best) of {_REPEATS.value}\n")
+    print("| object | pass | first call (s) | time (s) | rollouts/s | steps/s |")
+    print("|---|---|---:|---:|---:|---:|")
+    for name in _OBJECTS.value:
+        _measure(name, count, steps, reference)
+
+
+def _measure(name, count, steps, reference):
+    """Prints the rows of one object."""
+    obj = get_object(name)
+    paths, mus = random_pushes(obj, count, steps, _SEED.value)
+    shape = outline_jax.outline(obj)
+    l = jnp.full(count, limit_surface_ratio(obj), jnp.float32)
+    paths_j, mus_j = jnp.asarray(paths, jnp.float32), jnp.asarray(mus, jnp.float32)
+    poses0 = jnp.zeros((count, 3))
+
+    def final(path, pose, l, mu):
+        return rollout.rollout(shape, pose, path, l, mu).poses[-1]
+
+    forward = jax.jit(jax.vmap(final))
+    gradient = jax.jit(jax.vmap(jax.grad(lambda *args: jnp.sum(final(*args)), argnums=(0, 2, 3))))
+    for label, function in [("forward", lambda: forward(paths_j, poses0, l, mus_j)),
+                            ("grad w.r.t. path, l, mu", lambda: gradient(paths_j, poses0, l, mus_j))]:
+        first, median, best = _time(function, _REPEATS.value)
+        print(f"| {name} | {label} | {first:.1f} | {median:.3f} ({best:.3f}) | {count / median:,.0f} "
+              f"({count / best:,.0f}) | {count * steps / median:,.0f} |")
+    numpy_count = min(_NUMPY_PUSHES.value, count)
+    start = time.perf_counter()
+    numpy_rollouts(obj, paths[:numpy_count], limit_surface_ratio(obj), mus[:numpy_count], reference)
+    elapsed = time.perf_counter() - start
+    print(f"| {name} | NumPy loop, float64 ({numpy_count} pushes) | | {elapsed:.3f} | {numpy_count / elapsed:,.0f} "
+          f"| {numpy_count * steps / elapsed:,.0f} |")
+
+if __name__ == "__main__":
+    app.run(main)

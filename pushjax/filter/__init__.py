@@ -1,0 +1,9 @@
+"""Filters that track a pushed object's pose and infer latent physical parameters (pusher friction, limit-surface
+ratio) from motion-capture poses, with the JAX rollout step as the process model: an extended (``ekf``) and an
+unscented (``ukf``) Kalman filter and a particle filter (``particle``), sharing ``models``, and a
+constant-velocity baseline (``constant_velocity``); ``metrics`` scores them (pose RMSE, NEES and its chi-square
+band). ``tracking`` (not imported here: it needs the MuJoCo testbed) runs them on simulated testbed pushes."""
+
+from pushjax.filter import constant_velocity, ekf, metrics, models, particle, ukf
+
+__all__ = ["constant_velocity", "ekf", "metrics", "models", "particle", "ukf"]

@@ -1,0 +1,157 @@
+"""The state, process and observation models the filters share.
+
+State (``STATE_NAMES``, [5]): the object's tracked-frame pose (x m, y m, yaw rad, yaw unwrapped) augmented with
+two latent physical parameters as log scales of nominal values, ``mu = mu_nominal exp(log_mu_scale)`` (pusher
+friction) and ``l = l_nominal exp(log_l_scale)`` (limit-surface ratio), so a Gaussian belief keeps both
+positive.
+
+Process model (:func:`transition`): one step of the JAX rollout, :func:`pushjax.physics.rollout.step` (the
+contact annotated again on the outline, the pushing model of Lynch, or of the effects composed into
+:attr:`System.effects`), for the pusher's known motion over the step; the latents stay constant. Its noise
+(:attr:`System.process_std`, per step) stands for what the model leaves out: a Gaussian on the pose, and a small
+random walk on the latents so that they can follow slow changes.
+
+Observation model (:func:`observe`): the pose, as a motion-capture system measures it, with Gaussian noise
+(:attr:`System.measurement_std`). A dropped sample is a row of NaN (any NaN in the row): the filters skip the
+update there (predict only), they never read it as a zero. Yaw innovations are wrapped to (-pi, pi].
+
+Units: SI (m, rad). All functions are per push and pure; ``jax.vmap`` the filters over pushes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import NamedTuple
+
+import flax.struct
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from pushjax.geometry import outline_jax
+from pushjax.geometry.objects import PUSHER_RADIUS, PushObject, get_object, limit_surface_ratio
+from pushjax.physics import effects as effects_lib
+from pushjax.physics import rollout
+
+__all__ = ["POSE_SIZE", "STATE_NAMES", "STATE_SIZE", "System", "Track", "innovation", "make_system", "observe",
+           "observed", "physical", "transition", "update_linear"]
+
+STATE_NAMES = ("x", "y", "yaw", "log_mu_scale", "log_l_scale")
+STATE_SIZE = len(STATE_NAMES)
+POSE_SIZE = 3
+
+
+@flax.struct.dataclass
+class System:
+    """Everything the models need about one object (a pytree; ``effects`` is static).
+
+    Attributes:
+      shape: the object's outline (:func:`pushjax.geometry.outline_jax.outline`).
+      l: [] nominal limit-surface ratio, m.
+      mu: [] nominal pusher-object friction coefficient.
+      process_std: [5] standard deviation of the process noise per step (x m, y m, yaw rad, log mu, log l).
+      measurement_std: [3] standard deviation of a pose measurement (x m, y m, yaw rad).
+      radius: [] pusher radius, m.
+      params: the composed effects' parameters ({} for plain Lynch).
+      effects: names of the composed effects (static).
+    """
+
+    shape: outline_jax.Outline
+    l: jax.Array
+    mu: jax.Array
+    process_std: jax.Array
+    measurement_std: jax.Array
+    radius: jax.Array
+    params: dict
+    effects: tuple[str, ...] = flax.struct.field(pytree_node=False, default=())
+
+
+class Track(NamedTuple):
+    """A filter's output over a push: ``mean`` [T + 1, 5] and ``cov`` [T + 1, 5, 5], the belief after each
+    observation (the first after the first observation), and ``observed`` [T + 1] bool (the row was not dropped)."""
+
+    mean: jax.Array
+    cov: jax.Array
+    observed: jax.Array
+
+
+def make_system(obj: PushObject | str, mu: float = 0.25, l: float | None = None, *,
+                process_std: Sequence[float] = (2e-4, 2e-4, 3e-3, 1e-3, 1e-3),
+                measurement_std: Sequence[float] = (2e-4, 2e-4, 3e-3),
+                effects: Sequence[str] = (), params: dict | None = None, dtype=jnp.float32,
+                ellipse_points: int | None = None) -> System:
+    """The :class:`System` of `obj` with nominal `mu` and `l` (uniform pressure when omitted).
+
+    The default measurement noise is the realistic testbed's motion capture (0.2 mm, 3 mrad); the default process
+    noise is of the same size per step.
+    """
+    obj = get_object(obj) if isinstance(obj, str) else obj
+    l = limit_surface_ratio(obj) if l is None else l
+    process_std = np.asarray(process_std, np.float64)
+    measurement_std = np.asarray(measurement_std, np.float64)
+    if process_std.shape != (STATE_SIZE,) or np.any(process_std < 0):
+        raise ValueError(f"process_std: expected {STATE_SIZE} values >= 0, got {process_std.tolist()}")
+    if measurement_std.shape != (POSE_SIZE,) or np.any(measurement_std <= 0):
+        raise ValueError(f"measurement_std: expected {POSE_SIZE} values > 0, got {measurement_std.tolist()}")
+    if not (np.isfinite(mu) and mu > 0 and np.isfinite(l) and l > 0):
+        raise ValueError(f"mu, l: expected positive nominal values, got {mu}, {l}")
+    effects = tuple(effects)
+    params = effects_lib.init_params(effects) if params is None else params
+    return System(shape=outline_jax.outline(obj, dtype, ellipse_points), l=jnp.asarray(l, dtype),
+                  mu=jnp.asarray(mu, dtype), process_std=jnp.asarray(process_std, dtype),
+                  measurement_std=jnp.asarray(measurement_std, dtype), radius=jnp.asarray(PUSHER_RADIUS, dtype),
+                  params=jax.tree_util.tree_map(lambda x: jnp.asarray(x, dtype), params), effects=effects)
+
+
+def transition(system: System, state, pusher, increment):
+    """[5] state after one step of the pusher from `pusher` [2] by `increment` [2] (world, m)."""
+    pose, latents = state[:POSE_SIZE], state[POSE_SIZE:]
+    mu = system.mu * jnp.exp(latents[0])
+    l = system.l * jnp.exp(latents[1])
+    new_pose, _ = rollout.step(effects_lib.compose(system.effects), system.params, system.shape, pose, pusher,
+                               increment, l, mu, system.radius)
+    return jnp.concatenate([new_pose, latents])
+
+
+def observe(state):
+    """[3] the pose a measurement sees."""
+    return state[..., :POSE_SIZE]
+
+
+def observed(measurement):
+    """[] bool: the measurement [3] was not dropped (no NaN)."""
+    return jnp.all(jnp.isfinite(measurement))
+
+
+def innovation(measurement, predicted):
+    """[3] measurement minus predicted pose, yaw wrapped to (-pi, pi]; zeros for a dropped measurement."""
+    present = observed(measurement)
+    difference = jnp.where(present, measurement, predicted) - predicted
+    yaw = jnp.arctan2(jnp.sin(difference[2]), jnp.cos(difference[2]))
+    return difference.at[2].set(yaw)
+
+
+def update_linear(system: System, mean, cov, measurement):
+    """Kalman update of a Gaussian belief with a pose measurement (the observation is linear in the state); a
+    dropped measurement leaves the belief unchanged. Joseph form, symmetrised."""
+    h = jnp.eye(POSE_SIZE, STATE_SIZE, dtype=cov.dtype)
+    r = jnp.diag(system.measurement_std ** 2)
+    s = h @ cov @ h.T + r
+    gain = jnp.linalg.solve(s, h @ cov).T
+    new_mean = mean + gain @ innovation(measurement, observe(mean))
+    factor = jnp.eye(STATE_SIZE, dtype=cov.dtype) - gain @ h
+    new_cov = factor @ cov @ factor.T + gain @ r @ gain.T
+    new_cov = 0.5 * (new_cov + new_cov.T)
+    present = observed(measurement)
+    return jnp.where(present, new_mean, mean), jnp.where(present, new_cov, cov)
+
+
+def process_cov(system: System, dtype):
+    """[5, 5] process noise covariance per step."""
+    return jnp.diag(system.process_std.astype(dtype) ** 2)
+
+
+def physical(system: System, mean, cov):
+    """{"mu": [...], "mu_std_log": [...], "l": [...], "l_std_log": [...]}: the latents in physical units."""
+    return {"mu": system.mu * jnp.exp(mean[..., 3]), "mu_std_log": jnp.sqrt(cov[..., 3, 3]),
+            "l": system.l * jnp.exp(mean[..., 4]), "l_std_log": jnp.sqrt(cov[..., 4, 4])}

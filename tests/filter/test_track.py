@@ -1,0 +1,53 @@
+"""``python -m experiments.track --scale=smoke``: simulated testbed pushes tracked end to end."""
+
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from pushjax.filter import tracking
+from pushjax.sim.testbed import REALISTIC
+
+REPOSITORY = Path(__file__).resolve().parents[2]
+
+
+def test_smoke_run_writes_the_tables_and_the_figure(tmp_path):
+    result = subprocess.run(
+        [sys.executable, "-m", "experiments.track", "--scale=smoke", f"--workdir={tmp_path}",
+         "--testbed_overrides=drop_rate=0.2"],
+        cwd=REPOSITORY, env={**os.environ, "MUJOCO_GL": "egl"}, capture_output=True, text=True, timeout=600, check=False)
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert f"wrote {tmp_path / 'results.json'}" in result.stdout
+    results = json.loads((tmp_path / "results.json").read_text())
+    assert (tmp_path / "mu_over_time.png").stat().st_size > 1000
+    assert "| ekf |" in (tmp_path / "results.md").read_text()
+    summary = results["summary"]
+    assert set(summary) == {*tracking.FILTERS, "constant_velocity", "raw"}
+    for name, entry in summary.items():
+        assert all(math.isfinite(value) for value in entry.values()), (name, entry)
+        assert 0.0 < entry["position_rmse_mm"] < 5.0
+    # The raw measurements are the testbed's motion capture: their RMSE is its noise.
+    assert 0.5 < summary["raw"]["position_rmse_mm"] / (1e3 * math.sqrt(2) * REALISTIC.tracking_noise_xy) < 1.5
+    pushes = results["pushes"]
+    assert len(pushes) == tracking.SCALES["smoke"]["pushes"]
+    assert sum(push["dropped"] for push in pushes) > 0  # 20 % of the samples dropped: skipped, not zeros
+    for push in pushes:
+        for name in tracking.FILTERS:
+            mu = np.asarray(push["filters"][name]["mu"])
+            assert len(mu) == push["steps"] + 1 and np.all(np.isfinite(mu)) and np.all(mu > 0)
+
+
+def test_simulated_pushes_keep_their_truth_and_their_gaps():
+    pushes = tracking.simulate_pushes(["tri2"], 1, seed=3, testbed=REALISTIC.with_overrides("drop_rate=0.5"),
+                                      rate_hz=25.0)
+    push = pushes[0]
+    dropped = np.isnan(push.measurements[:, 0])
+    assert 0.2 < dropped.mean() < 0.8 and not dropped[0]
+    error = push.measurements[~dropped, :2] - push.truth[~dropped, :2]
+    assert np.abs(error).max() < 6 * REALISTIC.tracking_noise_xy
+    assert push.mu_true != push.mu_nominal > 0
+    assert len(push.pusher) == len(push.truth) > 50  # 25 Hz over a push of a few seconds
