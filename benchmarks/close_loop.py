@@ -49,7 +49,7 @@ def main():
         report = close_loop(data_dir, workdir, seed=args.seed)
         elapsed = time.perf_counter() - start
     pushes = len(recorded.written) + len(recorded.skipped)
-    print(json.dumps({key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "explained")},
+    print(json.dumps({key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "noise_floor", "explained")},
                      indent=1))
     print(f"close_loop on {pushes} pushes: {elapsed:.1f} s")
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Per-effect table of the closed loop: record each testbed case with its effect undeclared, run
 # `experiments.close_loop` on it, print baseline / after (held-out trans % + rot % of the zero
-# baseline), the cut, the selected effects, `explained` and the fallback's error.
+# baseline), the cut, the selected effects, the test split's noise floor, `explained` and the fallback's error.
 #   bash benchmarks/close_loop_effects.sh [WORK_DIR]     (run with the project's venv active)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -17,8 +17,8 @@ declare -A EFFECTS=(
   [tracking_bias]="tracking_bias=0.01,-0.006,0"
   [tracking_yaw_bias]="tracking_bias=0,0,0.12"
 )
-echo "| case | baseline | after | cut | selected | explained | fallback |"
-echo "|---|---:|---:|---:|---|---|---:|"
+echo "| case | baseline | after | cut | selected | noise floor | explained | fallback |"
+echo "|---|---:|---:|---:|---|---:|---|---:|"
 for name in clean com_offset pressure anisotropy table_tilt pusher_friction tracking_bias tracking_yaw_bias; do
   "$python" -m experiments.record_pushes --out_dir="$work/data/$name" --objects=rect1 --surfaces=pu \
     --velocities=20 --pushes=120 --seed=1 --effects="${EFFECTS[$name]}" --declare_effects=false \
@@ -28,9 +28,9 @@ for name in clean com_offset pressure anisotropy table_tilt pusher_friction trac
 import json, sys
 report = json.load(open(sys.argv[1]))
 total = lambda errors: errors["trans_pct"] + errors["rot_pct"]
-fallback = f"{total(report['fallback']['heldout']):.1f}" if report["fallback"] else "-"
 print(f"| {sys.argv[2]} | {total(report['baseline']):.1f} | {total(report['after']):.1f} | "
       f"{1 - total(report['after']) / total(report['baseline']):.0%} | "
-      f"{', '.join(report['selected']) or '-'} | {report['explained']} | {fallback} |", flush=True)
+      f"{', '.join(report['selected']) or '-'} | {total(report['noise_floor']):.1f} | {report['explained']} | "
+      f"{total(report['fallback']):.1f} |", flush=True)
 PY
 done

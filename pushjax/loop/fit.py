@@ -196,6 +196,12 @@ def _masks(candidates: Sequence[Sequence[str]], exact: bool) -> np.ndarray:
     return np.array([[name in candidate for name in _family_names(exact)] for candidate in candidates], np.float32)
 
 
+def _slots(count: int) -> int:
+    """Candidates are padded to a power of two: few compiled programs over the rounds of selection, and no exact
+    limit surface solved for many padding slots when one candidate needs it."""
+    return 1 << max(count - 1, 0).bit_length()
+
+
 def _stack(trees):
     return jax.tree.map(lambda *leaves: jnp.stack(leaves), *trees)
 
@@ -233,8 +239,7 @@ def fit_effects(
         if not members:
             continue
         names = _family_names(exact)
-        # The candidate axis is padded to the library size: one compiled program for every round of selection.
-        slots = max(len(names), len(members))
+        slots = _slots(len(members))
         group = [candidates[k] for k in members]
         masks = _masks(group + [()] * (slots - len(group)), exact)
         starts = []
@@ -316,7 +321,7 @@ def predict(results: Sequence[FitResult | None], examples: Examples) -> np.ndarr
         if not members:
             continue
         names = _family_names(exact)
-        slots = max(len(names), len(members))
+        slots = _slots(len(members))
         params = []
         for k in members + [None] * (slots - len(members)):
             full = effects_lib.init_params(names)

@@ -159,6 +159,11 @@ def markdown(report: dict, details: dict) -> str:
                      f"{round_['gains'][best]:+.3f}, p = {round_['p_values'][best]:.2g} (Holm level "
                      f"{round_['levels'][best]:.2g}); candidates beyond noise: "
                      f"{', '.join(name for name, passed in round_['beyond_noise'].items() if passed) or 'none'}")
+        for check in round_["mechanism"]:
+            verdict = ("not testable here (one group, or too few sequences per group)" if check["p_value"] is None
+                       else f"p = {check['p_value']:.2g} for agreement across {check['variable']}: "
+                       + ("**a knob, not a mechanism**" if check["p_value"] <= details["alpha"] else "a mechanism"))
+            lines.append(f"   - mechanism check of `{check['effect']}`: {verdict}")
     if report["selected"]:
         lines += ["", "Fitted parameters of the selected model (every pool push):", ""]
         lines += [f"- {name}: {_params_text(params)}" for name, params in details["selected_params"].items()]

@@ -14,7 +14,12 @@ subsumes ``friction_ratio`` and ``pressure_gradient``, replaces them) and tests 
   floor (:func:`pushjax.loop.metrics.noise_floor` of the selection windows): close to the floor, nothing more is
   there to explain.
 
-Among the candidates that pass both, the one with the largest gain is added; selection stops when none passes.
+* a mechanism, not a knob (:func:`check_mechanism`): the added effect's parameters, fitted separately on the pool
+  sequences of each object, surface or push velocity (where the data has several with enough sequences), agree
+  within their standard errors (Cochran's Q). Parameters that belong to one object (a pressure, a marker, a hidden
+  weight: ``Effect.per_object``) are compared across surfaces and velocities only.
+
+Among the candidates that pass, the one with the largest gain is added; selection stops when none passes.
 The selected set is then refitted on the whole pool; the test split is never used here.
 """
 
@@ -24,10 +29,12 @@ import dataclasses
 from collections.abc import Callable, Sequence
 
 import numpy as np
+from scipy import stats
 
 from pushjax.loop import fit as fit_lib
 from pushjax.loop import metrics
 from pushjax.loop.splits import Split
+from pushjax.loop.windows import Examples
 from pushjax.physics.effects import EFFECT_NAMES, EFFECTS
 
 MIN_GAIN = 0.05
@@ -57,6 +64,33 @@ class Candidate:
         return metrics.combined(self.summary)
 
 
+MECHANISM_GROUPS = ("object", "surface", "push velocity")
+"""Variables whose values split the pool into groups on which an added effect's parameters must agree."""
+MIN_GROUP_SEQUENCES = 8
+"""Fewest pool sequences of a group for :func:`check_mechanism` to fit the effect on it."""
+
+
+@dataclasses.dataclass(frozen=True)
+class MechanismCheck:
+    """Whether an effect's parameters agree across groups of the data.
+
+    Attributes:
+      effect: the added effect.
+      variable: the grouping variable with the smallest p-value, or None when no grouping could be tested.
+      p_value: Bonferroni-adjusted smallest heterogeneity p-value over the groupings and reported values (None: not
+        testable: one group, or groups with too few sequences).
+      values: {grouping variable: {group: {value name: {"value", "std"}}}} of the fits on each group.
+    """
+
+    effect: str
+    variable: str | None
+    p_value: float | None
+    values: dict[str, dict[str, dict[str, dict]]]
+
+    def is_knob(self, alpha: float) -> bool:
+        return self.p_value is not None and self.p_value <= alpha
+
+
 @dataclasses.dataclass(frozen=True)
 class Round:
     """One round of forward selection.
@@ -70,6 +104,7 @@ class Round:
       beyond_noise: whether Holm's procedure rejects "no gain" for each.
       floor: the gain (points of the combined score) an addition had to exceed: ``min_gain`` times the current
         error above the noise floor.
+      mechanism: the mechanism checks made in this round, in the order of the candidates' gains.
       accepted: the effect added in this round, or None (selection stops).
     """
 
@@ -80,6 +115,7 @@ class Round:
     levels: list[float]
     beyond_noise: list[bool]
     floor: float
+    mechanism: list[MechanismCheck]
     accepted: str | None
 
 
@@ -176,10 +212,16 @@ def select_effects(
         beyond_noise, levels = metrics.holm(p_values, alpha)
         required = min_gain * max(current.score - floor.score, 0.0)
         passing = np.flatnonzero(beyond_noise & (points > required))
-        best = int(passing[np.argmax(points[passing])]) if len(passing) else None
+        best, checks = None, []
+        for index in passing[np.argsort(-points[passing], kind="stable")]:
+            checks.append(check_mechanism(split.pool, candidates[index].effects, additions[index], settings,
+                                          candidates[index].fits[0].params))
+            if not checks[-1].is_knob(alpha):
+                best = int(index)
+                break
         rounds.append(Round(candidates=candidates, additions=additions, gains=gains,
                             p_values=[float(p) for p in p_values], levels=[float(level) for level in levels],
-                            beyond_noise=[bool(b) for b in beyond_noise], floor=float(required),
+                            beyond_noise=[bool(b) for b in beyond_noise], floor=float(required), mechanism=checks,
                             accepted=additions[best] if best is not None else None))
         if best is None:
             break
@@ -201,6 +243,40 @@ def select_effects(
         model = fit_lib.fit_effects([current.effects], split.pool, settings, initial=[current.fits[0].params])[0]
     return Selection(baseline=baseline, ranking=ranking, rounds=rounds, final=current, model=model,
                      noise_floor=floor)
+
+
+def check_mechanism(pool: Examples, effects: tuple[str, ...], added: str, settings: fit_lib.FitSettings,
+                    initial: dict) -> MechanismCheck:
+    """Fits ``effects`` on the pool sequences of each group and tests whether ``added``'s values agree.
+
+    For each variable of :data:`MECHANISM_GROUPS` with at least two groups of :data:`MIN_GROUP_SEQUENCES` sequences
+    (only ``surface`` and ``push velocity`` for a per-object effect), Cochran's Q of each reported value over the groups
+    (inverse-variance weights from the sandwich standard errors) against chi-square with groups - 1 degrees of freedom;
+    the smallest p-value times the number of tests is the check's p-value.
+    """
+    variables = [name for name in MECHANISM_GROUPS if not (EFFECTS[added].per_object and name == "object")]
+    values, tests = {}, []
+    for variable in variables:
+        labels = pool.variables[variable]
+        groups = [label for label in np.unique(labels)
+                  if len(np.unique(pool.sequence[labels == label])) >= MIN_GROUP_SEQUENCES]
+        if len(groups) < 2:
+            continue
+        fits = [fit_lib.fit_effects([effects], pool.select(labels == label), settings, initial=[initial])[0]
+                for label in groups]
+        values[variable] = {str(label): result.physical[added] for label, result in zip(groups, fits)}
+        for name in fits[0].physical[added]:
+            estimates = [result.physical[added][name] for result in fits]
+            if any(estimate["std"] is None or not estimate["std"] > 0 for estimate in estimates):
+                continue
+            value = np.array([estimate["value"] for estimate in estimates])
+            weight = 1.0 / np.array([estimate["std"] for estimate in estimates]) ** 2
+            q = float(np.sum(weight * (value - np.sum(weight * value) / np.sum(weight)) ** 2))
+            tests.append((float(stats.chi2.sf(q, len(groups) - 1)), variable))
+    if not tests:
+        return MechanismCheck(effect=added, variable=None, p_value=None, values=values)
+    p_value, variable = min(tests)
+    return MechanismCheck(effect=added, variable=variable, p_value=min(1.0, p_value * len(tests)), values=values)
 
 
 def _next_sets(current: tuple[str, ...], effects: Sequence[str]) -> tuple[list[tuple[str, ...]], list[str]]:

@@ -83,17 +83,17 @@ composed. The effects (the keys of :data:`EFFECTS`, applied in this order whatev
     ``E|r|^2 = (9/8) l^2``). One mechanism, so the shift and ``l`` move together (unlike ``cof_offset`` plus
     ``friction_ratio``).
 
-``limit_surface``  {"rim": [] -, "gradient": [2] -, object axes}
+``limit_surface``  {"rim": [] -}
     The exact limit surface of the support instead of Lynch's ellipsoid (which matches the exact one only at
     pure translation and pure rotation): the quasi-static, maximal-dissipation twist of the support described by
     ``PushInputs.support_points`` and ``support_weights`` (area weights of cells of the footprint,
     :func:`pushjax.geometry.support_cells`), solved by :func:`pushjax.physics.limit_surface.predict`. The support
-    pressure is ``area_k exp(rim (|r_k|^2 / E|r|^2 - 1) + gradient . r_k / sqrt(E|r|^2))``: ``rim > 0`` loads the rim
-    (a plate resting on its edge spins harder), ``rim < 0`` the centre, ``gradient`` moves the centre of pressure.
-    It replaces the ellipsoid, so its zero parameters are the exact surface of a uniform pressure, not Lynch's
+    pressure is ``area_k exp(rim (|r_k|^2 / E|r|^2 - 1))``: ``rim > 0`` loads the rim (a plate resting on its edge
+    spins harder), ``rim < 0`` the centre. A moved centre of pressure is ``cof_offset``, which moves this support with
+    it. It replaces the ellipsoid, so its zero parameter is the exact surface of a uniform pressure, not Lynch's
     model; it cannot be composed with the effects that change the ellipsoid (:data:`EFFECTS`' ``excludes``:
-    ``friction_ratio`` and ``pressure_gradient``, which its pressure modes subsume, and ``anisotropic_friction``,
-    which the exact surface does not model).
+    ``friction_ratio`` and ``pressure_gradient``, whose ``l`` it does not use, and ``anisotropic_friction``, which the
+    exact surface does not model).
 
 All branches are double-``where`` selections, so gradients are finite everywhere, including the
 no-effect parameters, ``normal = 0``, ``action = 0`` and ``s = 0``.
@@ -237,6 +237,8 @@ class Effect:
       solve: (params, state, inputs) -> twist about the centre of friction, replacing the ellipsoidal solve, or
         None (at most one composed effect has one).
       excludes: effects that cannot be composed with this one.
+      per_object: whether the parameters describe one object (its support, a marker, a hidden weight) rather than
+        the table, the pusher or the dynamics, so that they may differ between objects.
     """
 
     name: str
@@ -249,6 +251,7 @@ class Effect:
     general_solver: bool
     solve: Callable[[Params, ModelState, PushInputs], jax.Array] | None = None
     excludes: tuple[str, ...] = ()
+    per_object: bool = False
 
 
 def _rotate(vector: jax.Array, yaw: jax.Array) -> jax.Array:
@@ -448,10 +451,9 @@ def support_pressure(params: Params, points: jax.Array, area: jax.Array) -> jax.
     """[..., K] normalised support pressure of ``limit_surface`` at [..., K, 2] ``points`` (object axes, m) with
     area weights [..., K] (see the module docstring)."""
     area = area / jnp.sum(area, axis=-1, keepdims=True)
-    mean_square = jnp.sum(area * jnp.sum(points ** 2, axis=-1), axis=-1, keepdims=True)
-    radial = jnp.sum(points ** 2, axis=-1) / mean_square - 1.0
-    linear = jnp.sum(points * jnp.asarray(params["gradient"])[..., None, :], axis=-1) / jnp.sqrt(mean_square)
-    log_pressure = jnp.asarray(params["rim"])[..., None] * radial + linear
+    square = jnp.sum(points ** 2, axis=-1)
+    mean_square = jnp.sum(area * square, axis=-1, keepdims=True)
+    log_pressure = jnp.asarray(params["rim"])[..., None] * (square / mean_square - 1.0)
     weights = area * jnp.exp(log_pressure - jnp.max(log_pressure, axis=-1, keepdims=True))
     return weights / jnp.sum(weights, axis=-1, keepdims=True)
 
@@ -470,7 +472,7 @@ def _limit_surface_solve(params, state, inputs):
 
 
 def _limit_surface_physical(params):
-    return {"rim": params["rim"], "gradient_x": params["gradient"][..., 0], "gradient_y": params["gradient"][..., 1]}
+    return {"rim": params["rim"]}
 
 
 SPEED_REFERENCE = 0.02
@@ -493,11 +495,11 @@ EFFECTS: dict[str, Effect] = {
     effect.name: effect
     for effect in (
         Effect("frame_offset", _zeros(offset=(2,)), {"offset": 0.01}, _frame_offset_modify, None,
-               _identity, _offset_physical, False),
+               _identity, _offset_physical, False, per_object=True),
         Effect("cof_offset", _zeros(offset=(2,)), {"offset": 0.01}, _cof_offset_modify, None,
-               _identity, _offset_physical, False),
+               _identity, _offset_physical, False, per_object=True),
         Effect("friction_ratio", _zeros(log_scale=()), {"log_scale": 0.3}, _friction_ratio_modify, None,
-               _identity, lambda p: {"scale": jnp.exp(p["log_scale"])}, False),
+               _identity, lambda p: {"scale": jnp.exp(p["log_scale"])}, False, per_object=True),
         Effect("anisotropic_friction", _zeros(log_metric=(2,)), {"log_metric": 0.5},
                _anisotropic_friction_modify, None, _identity, _anisotropic_friction_physical, True),
         Effect("pusher_friction", _zeros(log_scale=()), {"log_scale": 0.5}, _pusher_friction_modify, None,
@@ -511,10 +513,10 @@ EFFECTS: dict[str, Effect] = {
         Effect("friction_speed", _zeros(inverse_deceleration=(), gain=()), {"inverse_deceleration": 0.3, "gain": 0.3},
                None, _friction_speed_correct, _friction_speed_project, _friction_speed_physical, False),
         Effect("pressure_gradient", _zeros(offset=(2,)), {"offset": 0.01}, _pressure_gradient_modify, None,
-               _identity, _pressure_gradient_physical, False),
-        Effect("limit_surface", _zeros(rim=(), gradient=(2,)), {"rim": 1.0, "gradient": 0.5}, None, None,
+               _identity, _pressure_gradient_physical, False, per_object=True),
+        Effect("limit_surface", _zeros(rim=()), {"rim": 1.0}, None, None,
                _identity, _limit_surface_physical, False, solve=_limit_surface_solve,
-               excludes=("friction_ratio", "pressure_gradient", "anisotropic_friction")),
+               excludes=("friction_ratio", "pressure_gradient", "anisotropic_friction"), per_object=True),
     )
 }
 """The library, in the order in which effects are applied."""

@@ -81,3 +81,32 @@ def test_error_correction_learns_what_the_model_misses(synthetic):
 def test_unknown_effects_are_rejected(synthetic):
     with pytest.raises(ValueError, match="unknown 'wind'"):
         fit.fit_effects([("wind",)], synthetic)
+
+
+def _two_surfaces(examples, scales):
+    """The windows labelled as two surfaces (alternate sequences), targets following pusher_friction with the
+    log-scale ``scales[surface]`` on each, plus 0.2 mm / 0.2 deg noise."""
+    surface = np.where(examples.sequence % 2 == 0, "abs", "pu")
+    target = np.zeros_like(examples.target)
+    for name, scale in scales.items():
+        truth = fit.FitResult(effects=("pusher_friction",), params={"pusher_friction": {"log_scale": np.array(scale)}},
+                              physical={}, loss=0.0)
+        target[surface == name] = fit.predict([truth], examples)[0][surface == name]
+    noise = np.random.default_rng(3).normal(size=target.shape) * np.array([2e-4, 2e-4, np.radians(0.2)])
+    return dataclasses.replace(examples, target=target + noise,
+                               variables={**examples.variables, "surface": surface})
+
+
+def test_an_effect_whose_parameters_flip_between_surfaces_is_a_knob(record):
+    examples, _ = build_examples(iter_pushes(record("clean")))
+    settings = fit.FitSettings(steps=150)
+    start = {"pusher_friction": {"log_scale": np.array(0.0)}}
+    same = select.check_mechanism(_two_surfaces(examples, {"abs": 0.5, "pu": 0.5}), ("pusher_friction",),
+                                  "pusher_friction", settings, start)
+    flipped = select.check_mechanism(_two_surfaces(examples, {"abs": 0.6, "pu": -0.6}), ("pusher_friction",),
+                                     "pusher_friction", settings, start)
+    assert same.variable == flipped.variable == "surface" and set(flipped.values["surface"]) == {"abs", "pu"}
+    assert not same.is_knob(0.05) and flipped.is_knob(0.05), (same.p_value, flipped.p_value)
+    # One surface, one object, one velocity: nothing to compare, so the check cannot call it a knob.
+    single = select.check_mechanism(examples, ("pusher_friction",), "pusher_friction", settings, start)
+    assert single.p_value is None and not single.is_knob(0.05)

@@ -367,15 +367,16 @@ def test_limit_surface_is_the_exact_surface_of_the_support_and_moves_with_its_pr
     np.testing.assert_allclose(model(zero, centred)[:, 2], 0.0, atol=1e-5)
     assert np.mean(np.abs(uniform - ellipsoid)) > 1e-5
     # Loading the rim makes turning harder; loading the centre easier.
-    rim = {"limit_surface": {"rim": jnp.asarray(1.0), "gradient": jnp.zeros(2)}}
-    centre = {"limit_surface": {"rim": jnp.asarray(-1.0), "gradient": jnp.zeros(2)}}
+    rim = {"limit_surface": {"rim": jnp.asarray(1.0)}}
+    centre = {"limit_surface": {"rim": jnp.asarray(-1.0)}}
     turned = np.abs(uniform[:, 2]) > 1e-3
     assert np.all(np.abs(np.asarray(model(rim, inputs))[turned, 2]) < np.abs(uniform[turned, 2]))
     assert np.all(np.abs(np.asarray(model(centre, inputs))[turned, 2]) > np.abs(uniform[turned, 2]))
-    # A pressure rising towards +x moves the centre of pressure there: a push through the centre of mass then turns
-    # the plate about the heavier side (counter-clockwise for a push along +y).
-    heavy_x = {"limit_surface": {"rim": jnp.asarray(0.0), "gradient": jnp.array([1.0, 0.0])}}
-    assert np.all(np.asarray(model(heavy_x, centred))[:, 2] > 1e-4)
+    # cof_offset moves the support with the centre of pressure: towards +x, a push along +y through the centre of
+    # mass passes on its left and turns the plate clockwise.
+    shifted = effects.compose(["cof_offset", "limit_surface"])
+    params = {"cof_offset": {"offset": jnp.array([0.005, 0.0])}, "limit_surface": {"rim": jnp.asarray(0.0)}}
+    assert np.all(np.asarray(shifted(params, centred))[:, 2] < -1e-4)
 
 
 def test_limit_surface_is_differentiable_and_refuses_what_it_cannot_compose():
@@ -383,10 +384,12 @@ def test_limit_surface_is_differentiable_and_refuses_what_it_cannot_compose():
     names = [name for name in effects.EFFECT_NAMES if effects.compatible([name, "limit_surface"])]
     model = effects.compose(names)
     params = {name: values for name, values in _random_params(3).items() if name in names}
-    params["limit_surface"] = {"rim": jnp.asarray(0.3), "gradient": jnp.array([0.2, -0.1])}
+    # (A random frame offset moves these pushes' contacts off the square's side: no motion to differentiate.)
+    params["frame_offset"] = {"offset": jnp.zeros(2)}
+    params["limit_surface"] = {"rim": jnp.asarray(0.3)}
     gradient = jax.grad(lambda p: jnp.sum(model(p, inputs) ** 2))(params)
     assert all(np.all(np.isfinite(leaf)) for leaf in jax.tree.leaves(gradient))
-    assert np.all(np.asarray(gradient["limit_surface"]["gradient"]) != 0)
+    assert np.asarray(gradient["limit_surface"]["rim"]) != 0 and np.all(np.asarray(gradient["cof_offset"]["offset"]) != 0)
     assert set(effects.EFFECT_NAMES) - set(names) == {"friction_ratio", "pressure_gradient", "anisotropic_friction"}
     with pytest.raises(ValueError, match="cannot compose limit_surface with friction_ratio"):
         effects.compose(["friction_ratio", "limit_surface"])
