@@ -9,7 +9,6 @@ the median (best) time over ``--repeats`` calls after the compiling first call.
 """
 
 import platform
-import time
 
 import jax
 import numpy as np
@@ -17,23 +16,12 @@ from absl import app, flags
 
 from pushjax.filter import ekf, metrics, models, particle, ukf
 from pushjax.geometry.objects import get_object
+from timing import time_calls
 
 _PUSHES = flags.DEFINE_integer("pushes", 256, "Pushes per batch.")
 _STEPS = flags.DEFINE_integer("steps", 50, "Steps per push.")
 _PARTICLES = flags.DEFINE_integer("particles", 256, "Particles of the particle filter.")
 _REPEATS = flags.DEFINE_integer("repeats", 3, "Timed calls per filter.")
-
-
-def _time(function, repeats):
-    start = time.perf_counter()
-    jax.block_until_ready(function())
-    first = time.perf_counter() - start
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        jax.block_until_ready(function())
-        times.append(time.perf_counter() - start)
-    return first, float(np.median(times)), float(np.min(times))
 
 
 def main(argv):
@@ -65,7 +53,7 @@ def main(argv):
             ("UKF", lambda: ukf.filter_pushes(system, mean, cov, paths, measurements)),
             (f"particle ({_PARTICLES.value})",
              lambda: particle.filter_pushes(system, keys, mean, cov, paths, measurements, count=_PARTICLES.value))]:
-        first, median, best = _time(function, _REPEATS.value)
+        first, median, best = time_calls(function, _REPEATS.value)
         print(f"| {name} | {first:.1f} | {median:.3f} ({best:.3f}) | {count / median:,.0f} | "
               f"{count * steps / median:,.0f} |")
 

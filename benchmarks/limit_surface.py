@@ -14,7 +14,6 @@ the machine may be shared, so compare the median with the best.
 
 import os
 import platform
-import time
 
 import jax
 import jax.numpy as jnp
@@ -22,6 +21,7 @@ import numpy as np
 from absl import app, flags
 
 from pushjax.physics import limit_surface, lynch
+from timing import seconds_per_call
 
 _BATCH = flags.DEFINE_integer("batch", 100_000, "Pushes per call.")
 _SUPPORTS = flags.DEFINE_list("supports", ["24", "64"], "Numbers K of support points.")
@@ -53,17 +53,6 @@ def random_pushes(batch: int, rng):
     mu = rng.uniform(0.1, 0.6, batch)
     s = rng.uniform(0, 1, batch)
     return contact, normal, action, mu, s
-
-
-def seconds_per_call(function, args, repeats: int) -> tuple[float, float]:
-    """(median, best) wall time of ``function(*args)`` after one warm-up call."""
-    jax.block_until_ready(function(*args))
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        jax.block_until_ready(function(*args))
-        times.append(time.perf_counter() - start)
-    return float(np.median(times)), float(np.min(times))
 
 
 def main(argv):

@@ -18,7 +18,6 @@ import importlib.util
 import os
 import pathlib
 import platform
-import time
 
 import jax
 import jax.numpy as jnp
@@ -26,6 +25,7 @@ import numpy as np
 from absl import app, flags
 
 from pushjax.physics import lynch
+from timing import seconds_per_call
 
 _BATCH = flags.DEFINE_integer("batch", 1_000_000, "Pushes per call.")
 _REPEATS = flags.DEFINE_integer("repeats", 20, "Timed calls per JAX measurement.")
@@ -91,17 +91,6 @@ def random_pushes(batch: int, dtype, seed: int):
     mu = rng.uniform(0.1, 0.6, batch)
     s = rng.uniform(0, 1, batch)
     return [x.astype(dtype) for x in (contact, normal, action, l, mu, s)]
-
-
-def seconds_per_call(function, args, repeats: int) -> tuple[float, float]:
-    """(median, best) wall time of ``function(*args)`` after one warm-up call."""
-    jax.block_until_ready(function(*args))
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        jax.block_until_ready(function(*args))
-        times.append(time.perf_counter() - start)
-    return float(np.median(times)), float(np.min(times))
 
 
 def main(argv):

@@ -28,6 +28,7 @@ from pushjax.geometry import contact as contact_lib
 from pushjax.geometry import outline_jax
 from pushjax.geometry.objects import PUSHER_RADIUS, get_object, limit_surface_ratio
 from pushjax.physics import rollout
+from timing import time_calls
 
 _PUSHES = flags.DEFINE_integer("pushes", 1000, "Pushes per batch.")
 _STEPS = flags.DEFINE_integer("steps", 100, "Steps per push.")
@@ -71,18 +72,6 @@ def numpy_rollouts(obj, paths, l, mu, reference):
     return pose
 
 
-def _time(function, repeats):
-    start = time.perf_counter()
-    jax.block_until_ready(function())
-    first = time.perf_counter() - start
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        jax.block_until_ready(function())
-        times.append(time.perf_counter() - start)
-    return first, float(np.median(times)), float(np.min(times))
-
-
 def main(argv):
     del argv
     reference = _load_numpy_reference()
@@ -111,7 +100,7 @@ def _measure(name, count, steps, reference):
     gradient = jax.jit(jax.vmap(jax.grad(lambda *args: jnp.sum(final(*args)), argnums=(0, 2, 3))))
     for label, function in [("forward", lambda: forward(paths_j, poses0, l, mus_j)),
                             ("grad w.r.t. path, l, mu", lambda: gradient(paths_j, poses0, l, mus_j))]:
-        first, median, best = _time(function, _REPEATS.value)
+        first, median, best = time_calls(function, _REPEATS.value)
         print(f"| {name} | {label} | {first:.1f} | {median:.3f} ({best:.3f}) | {count / median:,.0f} "
               f"({count / best:,.0f}) | {count * steps / median:,.0f} |")
     numpy_count = min(_NUMPY_PUSHES.value, count)

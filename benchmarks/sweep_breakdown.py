@@ -15,7 +15,6 @@ import os
 import platform
 import time
 
-import flax.linen as nn
 import jax
 import jax.numpy as jnp
 from absl import app, flags

@@ -9,7 +9,6 @@ for a dropped (NaN) sample. Jit-compiled; ``jax.vmap`` it over pushes (with :fun
 from __future__ import annotations
 
 import jax
-import jax.numpy as jnp
 
 from pushjax.filter import models
 
@@ -37,17 +36,7 @@ def filter_push(system: models.System, mean, cov, pusher_path, measurements) -> 
     Returns:
       The :class:`~pushjax.filter.models.Track` [T + 1].
     """
-    mean, cov = models.update_linear(system, mean, cov, measurements[0])
-
-    def body(belief, inputs):
-        pusher, increment, measurement = inputs
-        belief = models.update_linear(system, *predict(system, *belief, pusher, increment), measurement)
-        return belief, belief
-
-    _, (means, covs) = jax.lax.scan(body, (mean, cov),
-                                    (pusher_path[:-1], jnp.diff(pusher_path, axis=0), measurements[1:]))
-    return models.Track(mean=jnp.concatenate([mean[None], means]), cov=jnp.concatenate([cov[None], covs]),
-                        observed=jax.vmap(models.observed)(measurements))
+    return models.gaussian_filter(predict, system, mean, cov, pusher_path, measurements)
 
 
 @jax.jit

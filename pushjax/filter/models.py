@@ -146,6 +146,27 @@ def update_linear(system: System, mean, cov, measurement):
     return jnp.where(present, new_mean, mean), jnp.where(present, new_cov, cov)
 
 
+def gaussian_filter(predict, system: System, mean, cov, pusher_path, measurements) -> Track:
+    """A Gaussian filter over one push: the linear pose update, then ``predict`` and the update at every step.
+
+    Args:
+      predict: ``(system, mean, cov, pusher [2], increment [2]) -> (mean, cov)``, the filter's process step (EKF,
+        UKF).
+      system, mean, cov, pusher_path, measurements: as in :func:`pushjax.filter.ekf.filter_push`.
+    """
+    mean, cov = update_linear(system, mean, cov, measurements[0])
+
+    def body(belief, inputs):
+        pusher, increment, measurement = inputs
+        belief = update_linear(system, *predict(system, *belief, pusher, increment), measurement)
+        return belief, belief
+
+    _, (means, covs) = jax.lax.scan(body, (mean, cov),
+                                    (pusher_path[:-1], jnp.diff(pusher_path, axis=0), measurements[1:]))
+    return Track(mean=jnp.concatenate([mean[None], means]), cov=jnp.concatenate([cov[None], covs]),
+                 observed=jax.vmap(observed)(measurements))
+
+
 def process_cov(system: System, dtype):
     """[5, 5] process noise covariance per step."""
     return jnp.diag(system.process_std.astype(dtype) ** 2)

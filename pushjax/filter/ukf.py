@@ -48,17 +48,7 @@ def predict(system: models.System, mean, cov, pusher, increment):
 @jax.jit
 def filter_push(system: models.System, mean, cov, pusher_path, measurements) -> models.Track:
     """Filters one push; arguments and result as :func:`pushjax.filter.ekf.filter_push`."""
-    mean, cov = models.update_linear(system, mean, cov, measurements[0])
-
-    def body(belief, inputs):
-        pusher, increment, measurement = inputs
-        belief = models.update_linear(system, *predict(system, *belief, pusher, increment), measurement)
-        return belief, belief
-
-    _, (means, covs) = jax.lax.scan(body, (mean, cov),
-                                    (pusher_path[:-1], jnp.diff(pusher_path, axis=0), measurements[1:]))
-    return models.Track(mean=jnp.concatenate([mean[None], means]), cov=jnp.concatenate([cov[None], covs]),
-                        observed=jax.vmap(models.observed)(measurements))
+    return models.gaussian_filter(predict, system, mean, cov, pusher_path, measurements)
 
 
 @jax.jit
