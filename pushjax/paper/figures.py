@@ -184,7 +184,7 @@ def plot(results: Mapping, workdir: str | os.PathLike) -> list[Path]:
     name, rows, workdir = results["name"], tables.aggregate(results["rows"]), Path(workdir)
     size = lambda row: row["train_size"]  # noqa: E731
     curves = [curves_figure(results["curves"], workdir / "learning_curves.png")] if results.get("curves") else []
-    if name == "data_efficiency":
+    if name in ("data_efficiency", "data_efficiency_full"):
         return [line_figure(rows, size, "training examples", ["model"], workdir / "fig5_data_efficiency.png",
                             log_x=True), *curves]
     if name == "error_variants":

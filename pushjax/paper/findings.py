@@ -249,7 +249,7 @@ def _hybrid_first(results: Results):
         raise _Missing(f"no training size up to {SMALL_DATA_MAX}")
     comparisons, parts = [], []
     for size in small:
-        at = _need(cells(run, kind="trained", train_size=size), ("hybrid", "neural", "simple"))
+        at = _need(cells(run, kind="trained", train_size=size), ("hybrid", "neural"))
         others = [model for model in ("neural", "simple", "neural_dyn") if model in at]
         comparisons += _pairs(at, ("hybrid",), others, prefix=f"{size}: ")
         parts.append(f"at {size}: " + _listing({m: at[m] for m in ("hybrid", *others)}))

@@ -100,7 +100,8 @@ class ConvergedModel:
       converged: whether the criterion ended the constant phase (False: its budget did).
       constant_steps: steps at the constant learning rate.
       decay_steps: steps of the decay.
-      validation: [(step, score)] every validation score, the one after the decay last.
+      validation: [(step, trans_percent, rot_percent)] every validation evaluation (its score: their mean), the one
+        after the decay last.
       seconds: wall time of the training and its validation scores.
       steps_per_second: training steps per second (validation excluded).
     """
@@ -110,7 +111,7 @@ class ConvergedModel:
     converged: bool
     constant_steps: int
     decay_steps: int
-    validation: list[tuple[int, float]]
+    validation: list[tuple[int, float, float]]
     seconds: float
     steps_per_second: float
 
@@ -119,10 +120,10 @@ class ConvergedModel:
         return self.constant_steps + self.decay_steps
 
 
-def validation_score(model: PushModel, state: TrainState, examples: Examples, batch_size: int) -> float:
-    """The mean of the translation and rotation errors in % of zero of `state` on `examples`."""
+def validation_errors(model: PushModel, state: TrainState, examples: Examples, batch_size: int) -> tuple[float, float]:
+    """The translation and rotation errors in % of zero of `state` on `examples`; their mean is the score."""
     metrics = error_metrics(predict(model, state, examples, batch_size), examples)
-    return (metrics["trans_percent"] + metrics["rot_percent"]) / 2.0
+    return float(metrics["trans_percent"]), float(metrics["rot_percent"])
 
 
 def _with_learning_rate(state: TrainState, value: float) -> TrainState:
@@ -161,13 +162,14 @@ def train_until_converged(
     step_fn = jax.jit(make_train_step(model, optimizer, train_config.weight_decay))
     budget = criterion.budget(size)
     scores: list[float] = []
-    history: list[tuple[int, float]] = []
+    history: list[tuple[int, float, float]] = []
     started, train_seconds = time.monotonic(), 0.0
     step, converged = 0, False
 
     def score_now(label: str) -> float:
-        score = validation_score(model, state, validation, train_config.eval_batch_size)
-        history.append((step, float(score)))
+        trans, rot = validation_errors(model, state, validation, train_config.eval_batch_size)
+        score = (trans + rot) / 2.0
+        history.append((step, trans, rot))
         if log is not None:
             log(f"{spec.name}: step {step} ({label}) validation score {score:.2f}")
         return score

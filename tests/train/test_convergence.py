@@ -38,9 +38,9 @@ def test_train_until_converged(smoke, improvement, budget, converged):
     assert model.converged is converged
     assert model.constant_steps == (15 if converged else 10) and model.decay_steps == 3 and model.steps == \
         int(model.state.step)
-    assert [step for step, _ in model.validation] == ([5, 10, 15, 18] if converged else [5, 10, 13])
-    assert len(lines) == len(model.validation) and all(np.isfinite(score) for _, score in model.validation)
+    assert [step for step, *_ in model.validation] == ([5, 10, 15, 18] if converged else [5, 10, 13])
+    assert len(lines) == len(model.validation) and np.isfinite(model.validation).all()
     learning_rate = float(model.state.opt_state.hyperparams["learning_rate"])
     assert learning_rate == pytest.approx(TINY_SMOKE.learning_rate * criterion.final_lr_fraction, rel=1e-5)
-    assert model.validation[-1][1] == pytest.approx(
-        convergence.validation_score(model.model, model.state, validation, 64))
+    assert model.validation[-1][1:] == pytest.approx(
+        convergence.validation_errors(model.model, model.state, validation, 64))
