@@ -389,6 +389,28 @@ def _unseen_objects(results: Results):
     return comparisons, "rotation error [%]: " + "; ".join(parts)
 
 
+def view_cost(top_down: Mapping, free: Mapping, metric: str = "trans_percent", model: str = "hybrid") -> dict:
+    """What the free camera costs `model` (Sec. V), compared on each view's own test split against physics.
+
+    The two views are tested on different splits (``data_efficiency`` and ``viewpoint``), so each view's error is
+    first taken against the physics baseline on the same sequences (a paired bootstrap), and the cost is the
+    difference of those two: (free − physics on free's split) − (top-down − physics on top-down's split), their
+    standard errors combined as independent. Both at each run's largest training size.
+
+    Returns:
+      {"top_down": Estimate, "free": Estimate (model − physics on each split), "cost": Estimate, "sizes": (top, free)}.
+    """
+    against = {}
+    sizes = []
+    for name, run in (("top_down", top_down), ("free", free)):
+        size = _sizes(run)[-1]
+        trained = _need(cells(run, metric, kind="trained", train_size=size), (model,))
+        baseline = _need(cells(run, metric, kind="baseline"), ("physics",))
+        against[name] = statistics.difference(trained[model], baseline["physics"])
+        sizes.append(size)
+    return {**against, "cost": statistics.difference(against["free"], against["top_down"]), "sizes": tuple(sizes)}
+
+
 _DATA_EFFICIENCY = "|".join(DATA_EFFICIENCY_RUNS)
 
 CHECKS: dict[str, tuple[str, str, Callable[[Results], tuple[list[Comparison], str]]]] = {

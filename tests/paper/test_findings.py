@@ -192,3 +192,19 @@ def test_findings_binary_rejects_missing_and_foreign_files(tmp_path):
     (tmp_path / "results.json").write_text(json.dumps([1, 2]))
     with pytest.raises(app.UsageError, match="is not a results.json"):
         run_binary("findings", f"--workdirs={tmp_path}")
+
+
+def test_view_cost_is_paired_on_each_split():
+    top = _full({2500: {"hybrid": 30.0}, 20000: {"hybrid": 22.0}}, name="data_efficiency", physics=20.0)
+    free = {"viewpoint": {"name": "viewpoint", "config": {}, "rows": [
+        _sequence_row("physics", 21.0, noise=0.05, sequences=40),
+        *[_sequence_row("hybrid", 25.0 + 0.1 * (seed - 1), size=20000, seed=seed, noise=0.05, sequences=40)
+          for seed in range(3)]]}}
+    cost = findings.view_cost(top["data_efficiency"], free["viewpoint"])
+    assert cost["sizes"] == (20000, 20000)
+    assert cost["top_down"].value == pytest.approx(2.0) and cost["free"].value == pytest.approx(4.0)
+    assert cost["cost"].value == pytest.approx(2.0)
+    # Paired on its split each difference is tighter than the two cells' errors combined; the cost combines the two
+    # differences as independent.
+    assert cost["cost"].se == pytest.approx(np.hypot(cost["top_down"].se, cost["free"].se))
+    assert cost["cost"].replicates is None
