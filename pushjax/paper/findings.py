@@ -17,7 +17,8 @@ the difference exceeds `MARGIN` standard errors (`CLEAR_MARGIN` when the paper s
   our data stop before the paper's condition.
 
 The data-efficiency findings read ``data_efficiency_full`` (the paper's composition and sizes, issue 30) when it is
-among the results, else ``data_efficiency``.
+among the results and has trained every model it planned, else ``data_efficiency`` (else an incomplete
+``data_efficiency_full``).
 """
 
 from __future__ import annotations
@@ -153,12 +154,23 @@ def _need(at: Mapping, models: Sequence[str]) -> Mapping:
     return at
 
 
+def _complete(run: Mapping) -> bool:
+    """Whether a run trained every model it planned (``progress`` of `pushjax.paper.full_run`; other runs are)."""
+    return not run.get("progress", {}).get("missing")
+
+
+def _choose(results: Results, names: Sequence[str]) -> str | None:
+    """The first of `names` in `results` that is complete, else the first present, else None."""
+    present = [name for name in names if name in results]
+    return next((name for name in present if _complete(results[name])), present[0] if present else None)
+
+
 def _data_efficiency(results: Results) -> Mapping:
-    """The first of `DATA_EFFICIENCY_RUNS` in `results`."""
-    for name in DATA_EFFICIENCY_RUNS:
-        if name in results:
-            return results[name]
-    raise _Missing(f"no {' or '.join(DATA_EFFICIENCY_RUNS)} results")
+    """The run of `DATA_EFFICIENCY_RUNS` that decides the Table 1 findings (`_choose`)."""
+    name = _choose(results, DATA_EFFICIENCY_RUNS)
+    if name is None:
+        raise _Missing(f"no {' or '.join(DATA_EFFICIENCY_RUNS)} results")
+    return results[name]
 
 
 def _small_data(results: Results):
@@ -468,7 +480,7 @@ def check(results: Results) -> list[Finding]:
     """Every finding of `CHECKS` decided on `results` (binary name -> results.json contents)."""
     findings = []
     for key, (statement, experiments, comparisons_of) in CHECKS.items():
-        experiment = next((name for name in experiments.split("|") if name in results), None)
+        experiment = _choose(results, experiments.split("|"))
         if experiment is None:
             findings.append(Finding(key, statement, experiments.split("|")[-1], UNCHECKED,
                                     f"no {' or '.join(experiments.split('|'))} results"))

@@ -87,9 +87,13 @@ def test_full_set_findings_and_the_crossover():
     low, high = found["interval"]  # the difference at 50 k is 0 ± a little: the crossing stays between 20 k and 190 k
     assert 20000 < low <= 50000 <= high < 190000 and found["not_crossing"] == 0.0
     assert "data_efficiency_full" in {f.experiment for f in findings.check(results)}
-    # The published data_efficiency run is read only when the full one is missing.
-    assert _verdicts({**results, **_full({2500: models(45.0, 35.0)}, name="data_efficiency")})["crossover"] \
-        == findings.HOLDS
+    # The published data_efficiency run is read only when the full one is missing or incomplete.
+    published = _full({2500: models(45.0, 35.0)}, name="data_efficiency")
+    assert _verdicts({**results, **published})["crossover"] == findings.HOLDS
+    results["data_efficiency_full"]["progress"] = {"missing": ["hybrid_190080_seed0_wide"]}
+    assert {f.experiment for f in findings.check({**results, **published})} >= {"data_efficiency"}
+    assert _verdicts({**results, **published})["crossover"] == findings.NOT_REACHED.format(size=2500)
+    assert _verdicts(results)["crossover"] == findings.HOLDS  # incomplete, but the only one
 
 
 def test_full_set_findings_not_reached_below_the_full_set():
