@@ -2,10 +2,10 @@ r"""Which of the paper's qualitative findings hold, from the results of the expe
 
   python -m experiments.findings --workdirs=DIR[,DIR...] [--output=FILE]
 
-Each DIR is the --workdir of a finished run of data_efficiency, new_pushes, velocities, error_velocities,
-error_variants or objects; prints (and with --output writes) a markdown table: the paper's finding, the verdict on
-our testbed (holds / does not hold / not decidable / not checked, criteria in `pushjax.paper.findings`) and the
-numbers behind it.
+Each DIR is the --workdir of a finished run of data_efficiency, data_efficiency_full, new_pushes, velocities,
+error_velocities, error_variants or objects; prints (and with --output writes) a markdown table: the paper's finding,
+the verdict on our testbed (holds / does not hold / not decidable / not checked / not reached at N, criteria in
+`pushjax.paper.findings`) and the numbers behind it.
 """
 
 from pathlib import Path

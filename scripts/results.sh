@@ -57,5 +57,5 @@ run objects
 run velocities
 share velocities error_velocities train_20/l1/neural train_20/l1/hybrid
 run error_velocities
-"$python" -m experiments.findings --workdirs="$(ls -d "$published"/{data_efficiency,new_pushes,velocities,error_velocities,error_variants,objects} 2>/dev/null | paste -sd,)" \
+"$python" -m experiments.findings --workdirs="$(ls -d "$published"/{data_efficiency,data_efficiency_full,new_pushes,velocities,error_velocities,error_variants,objects} 2>/dev/null | paste -sd,)" \
   --output="$published/findings.md"

@@ -43,6 +43,12 @@ Scales:
     axis (``paper``: 0.75 mm); a learned localiser interpolates below a pixel, but expect its position error
     to be about a millimetre larger than at ``paper`` resolution, with the object's motion over 0.5 s at
     20 mm/s being about 10 mm.
+``cpu_full``
+    The paper's composition at ``cpu`` images (issue 30): all 11 objects on all four surfaces at 20 mm/s without
+    acceleration, 66 push sequences per object and surface plus 8 per object for validation, 72 examples per
+    sequence, 64 x 64 images and 20 x 20 px glimpses. ``data_efficiency``: 2 640 training sequences (190 080
+    examples), 528 test sequences (38 016 examples) and 88 validation sequences (6 336 examples), as the paper's
+    191 k / 38 k.
 ``paper``
     The paper's sizes: ``data_efficiency`` 191 k / 38 k, ``new_pushes`` about 114 k / 23 k / 91 k,
     ``objects`` 35 k per training set, ``viewpoint`` 191 k / 38 k, ``repeated`` 200; 128 x 128 images and
@@ -71,10 +77,11 @@ from pushjax.mit.files import PushParams, push_file_path
 from pushjax.mit.protocol import MIT_ANGLES, side_points
 from pushjax.sim.dataset import PushJob, plan_pushes
 from pushjax.sim.effects import Effects
+from pushjax.sim.surfaces import SURFACE_NAMES
 from pushjax.sim.testbed import DEFAULT_PROFILE, PROFILES, Testbed
 
 EXPERIMENTS = ("data_efficiency", "new_pushes", "velocities", "objects", "viewpoint", "repeated")
-SCALES = ("smoke", "cpu", "paper")
+SCALES = ("smoke", "cpu", "cpu_full", "paper")
 DEFAULT_SCALE = "cpu"
 
 TRAIN_VELOCITY = 20.0
@@ -194,6 +201,8 @@ _SIZES = {
                   image_size=64, glimpse_size=20),
     "cpu": dict(pushes_per_object=30, test_pushes_per_object=5, windows_per_sequence=24, transforms_per_window=3,
                 image_size=64, glimpse_size=20),
+    "cpu_full": dict(pushes_per_object=66, test_pushes_per_object=8, windows_per_sequence=24,
+                     transforms_per_window=3, image_size=64, glimpse_size=20, surfaces=SURFACE_NAMES),
     "paper": dict(pushes_per_object=290, test_pushes_per_object=48, windows_per_sequence=24,
                   transforms_per_window=3, image_size=128, glimpse_size=80),
 }

@@ -12,7 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from pushjax.paper import tables  # noqa: E402
+from pushjax.paper import reference, tables  # noqa: E402
 
 PANELS = (("trans_percent", "translation error [% of zero]"), ("rot_percent", "rotation error [% of zero]"))
 MODEL_ORDER = ("zero", "physics", "neural", "neural_dyn", "hybrid", "simple", "error", "error_grad", "error_norm")
@@ -62,11 +62,13 @@ def _finish(figure, axes, path) -> Path:
 
 
 def line_figure(rows: Sequence[Mapping], x: Callable[[Mapping], float], x_label: str,
-                series_keys: Sequence[str], path: str | os.PathLike, log_x: bool = False) -> Path:
+                series_keys: Sequence[str], path: str | os.PathLike, log_x: bool = False,
+                paper_points: Mapping[str, Sequence[tuple[float, Mapping[str, float]]]] | None = None) -> Path:
     """Trans. and rot. errors (± s.e.) against ``x(row)``, a line per distinct `series_keys`.
 
     The colour says the model (`MODEL_COLOURS`), the line style and marker the other series keys. Rows where
-    ``x(row)`` is None (baselines without a training size) are drawn as horizontal lines.
+    ``x(row)`` is None (baselines without a training size) are drawn as horizontal lines. `paper_points`: model ->
+    [(x, {metric: value})], the paper's values, drawn as hollow diamonds in the model's colour.
     """
     series = _series(rows, series_keys)
     variant = _variant_index(series)
@@ -85,6 +87,13 @@ def line_figure(rows: Sequence[Mapping], x: Callable[[Mapping], float], x_label:
                               color=colour, capsize=3, label=name)
             else:
                 axis.axhline(_value(members[0], metric), linestyle="--", color=colour, linewidth=1.2, label=name)
+        for model, points in (paper_points or {}).items():
+            points = [(px, values[metric]) for px, values in points if metric in values]
+            if points:
+                xs, ys = map(np.asarray, zip(*points))
+                xs_seen.update(xs.tolist())
+                axis.plot(xs, ys, linestyle="none", marker="D", markerfacecolor="none", markersize=8,
+                          color=_colour(model), label=f"{model} (paper)")
         axis.set_xlabel(x_label)
         axis.set_ylabel(label)
         if log_x:
@@ -179,11 +188,27 @@ def _velocity(row):
     return float(digits) if digits else None
 
 
+def paper_table1_points() -> dict[str, list[tuple[float, dict[str, float]]]]:
+    """model -> [(size, {"trans_percent", "rot_percent"})] of the paper's Table 1 (2 500 and 190 000 examples);
+    {} without the paper's tables."""
+    table = reference.tables().get("table1_data_efficiency", {})
+    points: dict[str, list] = {}
+    for size in ("2500", "190000"):
+        for model, cell in table.get(size, {}).items():
+            values = {metric: cell[key][0] for metric, key in (("trans_percent", "trans"), ("rot_percent", "rot"))
+                      if key in cell}
+            points.setdefault(model, []).append((float(size), values))
+    return points
+
+
 def plot(results: Mapping, workdir: str | os.PathLike) -> list[Path]:
     """The figures of one experiment (chosen by ``results["name"]``), written to `workdir` as PNG."""
     name, rows, workdir = results["name"], tables.aggregate(results["rows"]), Path(workdir)
     size = lambda row: row["train_size"]  # noqa: E731
     curves = [curves_figure(results["curves"], workdir / "learning_curves.png")] if results.get("curves") else []
+    if name == "data_efficiency_full":
+        return [line_figure(rows, size, "training examples", ["model"], workdir / "fig5_data_efficiency.png",
+                            log_x=True, paper_points=paper_table1_points()), *curves]
     if name == "data_efficiency":
         return [line_figure(rows, size, "training examples", ["model"], workdir / "fig5_data_efficiency.png",
                             log_x=True), *curves]

@@ -11,16 +11,26 @@ the difference exceeds `MARGIN` standard errors (`CLEAR_MARGIN` when the paper s
 * a finding **holds** when every comparison it makes is decided in its favour;
 * it **does not hold** when any comparison is decided against it;
 * it is **not decidable** otherwise (some difference within the errors);
-* it is **not checked** when its experiment or models are missing.
+* it is **not checked** when its experiment or models are missing;
+* a finding about the paper's full training set (190 k examples) whose largest training size is below
+  `FULL_SET_MIN` and that does not hold there is **not reached at N** (N: our largest size), not "does not hold":
+  our data stop before the paper's condition.
+
+The data-efficiency findings read ``data_efficiency_full`` (the paper's composition and sizes, issue 30) when it is
+among the results and has trained every model it planned, else ``data_efficiency`` (else an incomplete
+``data_efficiency_full``).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import os
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+
+import numpy as np
 
 from pushjax.paper import statistics, tables
 from pushjax.paper.statistics import Estimate
@@ -31,6 +41,17 @@ CLEAR_MARGIN = 2.0
 """The margin of a finding the paper states as "clearly"."""
 
 HOLDS, FAILS, UNDECIDED, UNCHECKED = "holds", "does not hold", "not decidable", "not checked"
+NOT_REACHED = "not reached at {size}"
+"""The verdict of a full-set finding that does not hold at a largest size below `FULL_SET_MIN`."""
+
+FULL_SET_MIN = 150_000
+"""The smallest largest-training-size that counts as the paper's full set (190 k) for the full-set findings."""
+SMALL_DATA_MAX = 20_000
+"""The paper's "more than 20 k training examples": sizes up to this one are where hybrid is not yet reached."""
+DATA_EFFICIENCY_RUNS = ("data_efficiency_full", "data_efficiency")
+"""The experiments that decide the Table 1 findings, the first present one is read."""
+CROSSOVER_LEVEL = 0.95
+"""The coverage of the crossover's bootstrap interval."""
 
 Results = Mapping[str, Mapping]
 """binary name (``data_efficiency``, ``new_pushes``, ``velocities``, ...) -> the contents of its results.json."""
@@ -133,8 +154,27 @@ def _need(at: Mapping, models: Sequence[str]) -> Mapping:
     return at
 
 
+def _complete(run: Mapping) -> bool:
+    """Whether a run trained every model it planned (``progress`` of `pushjax.paper.full_run`; other runs are)."""
+    return not run.get("progress", {}).get("missing")
+
+
+def _choose(results: Results, names: Sequence[str]) -> str | None:
+    """The first of `names` in `results` that is complete, else the first present, else None."""
+    present = [name for name in names if name in results]
+    return next((name for name in present if _complete(results[name])), present[0] if present else None)
+
+
+def _data_efficiency(results: Results) -> Mapping:
+    """The run of `DATA_EFFICIENCY_RUNS` that decides the Table 1 findings (`_choose`)."""
+    name = _choose(results, DATA_EFFICIENCY_RUNS)
+    if name is None:
+        raise _Missing(f"no {' or '.join(DATA_EFFICIENCY_RUNS)} results")
+    return results[name]
+
+
 def _small_data(results: Results):
-    run = results["data_efficiency"]
+    run = _data_efficiency(results)
     size = _sizes(run)[0]
     at = _need(cells(run, kind="trained", train_size=size), ("hybrid", "error", "neural", "simple"))
     comparisons = _pairs(at, ("hybrid", "error"), ("neural", "simple"), CLEAR_MARGIN)
@@ -142,11 +182,141 @@ def _small_data(results: Results):
 
 
 def _most_data(results: Results):
-    run = results["data_efficiency"]
+    run = _data_efficiency(results)
     size = _sizes(run)[-1]
     at = _need(cells(run, kind="trained", train_size=size), ("neural", "simple", "hybrid", "error"))
     comparisons = _pairs(at, ("neural",), ("simple", "hybrid", "error"))
     return comparisons, f"at {size} examples: " + _listing({m: at[m] for m in ("neural", "simple", "hybrid", "error")})
+
+
+def _crossing(sizes: Sequence[int], differences: Sequence[float]) -> float | None:
+    """Where `differences` (neural − hybrid per size) first turn negative, interpolated in log(size) between the
+    last size at which it is >= 0 and the next; the smallest size when it is negative from the start; None when
+    it never is."""
+    for index, value in enumerate(differences):
+        if value < 0:
+            if index == 0:
+                return float(sizes[0])
+            before, after = differences[index - 1], value
+            fraction = before / (before - after)
+            low, high = math.log(sizes[index - 1]), math.log(sizes[index])
+            return float(math.exp(low + fraction * (high - low)))
+    return None
+
+
+def crossover(run: Mapping, better: str = "neural", worse: str = "hybrid") -> dict:
+    """Where `better` overtakes `worse` over the training sizes of `run`.
+
+    Returns a dict: ``sizes``; ``differences`` (`Estimate` of better − worse per size, paired over sequences);
+    ``decided`` (the smallest size at which better is better by more than `MARGIN` standard errors, or None);
+    ``estimate`` (`_crossing` of the mean differences, or None); ``interval`` ((low, high) of `_crossing` over
+    the sequence-bootstrap replicates of the differences, a `CROSSOVER_LEVEL` percentile interval; None for a
+    bound beyond the largest size, i.e. more than (1 − level) / 2 of the replicates do not cross; the whole
+    interval None without replicates); ``not_crossing`` (the share of replicates that never cross).
+    """
+    sizes = _sizes(run)
+    differences = []
+    for size in sizes:
+        at = _need(cells(run, kind="trained", train_size=size), (better, worse))
+        differences.append(statistics.difference(at[better], at[worse]))
+    decided = next((size for size, d in zip(sizes, differences) if d.value < -MARGIN * (d.se or 0.0)), None)
+    estimate = _crossing(sizes, [d.value for d in differences])
+    interval, not_crossing = None, None
+    if differences and all(d.replicates is not None for d in differences):
+        replicates = np.stack([d.replicates for d in differences], axis=1)  # [B, sizes]
+        crossings = [_crossing(sizes, row) for row in replicates]
+        not_crossing = sum(c is None for c in crossings) / len(crossings)
+        ordered = np.sort([math.inf if c is None else c for c in crossings])
+        tail = (1.0 - CROSSOVER_LEVEL) / 2.0
+        bounds = [float(np.quantile(ordered, q, method="lower" if q < 0.5 else "higher")) for q in (tail, 1 - tail)]
+        interval = tuple(None if math.isinf(b) else b for b in bounds)
+    return {"sizes": sizes, "differences": differences, "decided": decided, "estimate": estimate,
+            "interval": interval, "not_crossing": not_crossing}
+
+
+def _size_text(size: float | None, largest: int) -> str:
+    return f"> {largest}" if size is None else f"{size:,.0f}".replace(",", " ")
+
+
+def _crossover(results: Results):
+    run = _data_efficiency(results)
+    found = crossover(run)
+    sizes, largest = found["sizes"], found["sizes"][-1]
+    text = (f"neural − hybrid by size: " + ", ".join(f"{size}: {d}" for size, d in zip(sizes, found["differences"]))
+            + f"; first size where neural is better by {MARGIN:g} s.e.: "
+            + ("none" if found["decided"] is None else str(found["decided"]))
+            + f"; crossing (log-size interpolation): {_size_text(found['estimate'], largest)}")
+    if found["interval"] is not None:
+        low, high = found["interval"]
+        text += (f", {CROSSOVER_LEVEL:.0%} sequence-bootstrap interval [{_size_text(low, largest)}, "
+                 f"{_size_text(high, largest)}] ({found['not_crossing']:.0%} of the replicates do not cross)")
+    comparisons = [Comparison(f"{largest}: neural − hybrid", found["differences"][-1], MARGIN)]
+    return comparisons, text
+
+
+def _hybrid_first(results: Results):
+    run = _data_efficiency(results)
+    small = [size for size in _sizes(run) if size <= SMALL_DATA_MAX]
+    if not small:
+        raise _Missing(f"no training size up to {SMALL_DATA_MAX}")
+    comparisons, parts = [], []
+    for size in small:
+        at = _need(cells(run, kind="trained", train_size=size), ("hybrid", "neural"))
+        others = [model for model in ("neural", "simple", "neural_dyn") if model in at]
+        comparisons += _pairs(at, ("hybrid",), others, prefix=f"{size}: ")
+        parts.append(f"at {size}: " + _listing({m: at[m] for m in ("hybrid", *others)}))
+    return comparisons, "; ".join(parts)
+
+
+def _only_neural_error(results: Results):
+    run = _data_efficiency(results)
+    size = _sizes(run)[-1]
+    at = dict(_need(cells(run, kind="trained", train_size=size), ("neural", "error", "hybrid", "simple")))
+    at.update(_need(cells(run, kind="baseline"), ("physics",)))
+    others = [model for model in ("hybrid", "simple", "neural_dyn") if model in at]
+    comparisons = _pairs(at, ("neural", "error"), ("physics",)) + _pairs(at, ("physics",), others)
+    return comparisons, f"at {size} examples: " + _listing({m: at[m] for m in ("physics", "neural", "error", *others)})
+
+
+def _neural_dyn(results: Results):
+    run = _data_efficiency(results)
+    size = _sizes(run)[-1]
+    at = _need(cells(run, kind="trained", train_size=size), ("neural", "neural_dyn"))
+    return _pairs(at, ("neural",), ("neural_dyn",)), f"at {size} examples: " + _listing(
+        {m: at[m] for m in ("neural", "neural_dyn")})
+
+
+def _error_velocities(results: Results):
+    run = results["velocities"]
+    several = sorted({row["train_split"] for row in run["rows"] if row["kind"] == "trained"} - {"train_20"})
+    if not several:
+        raise _Missing("needs models trained on more than one velocity")
+    one = _degradation(run, "train_20", ("hybrid", "error"))
+    comparisons = [_compare("train_20: hybrid − error", one["hybrid"], one["error"])]
+    parts = [f"train_20: " + _listing(one)]
+    for split in several:
+        more = _degradation(run, split, ("error",))
+        comparisons.append(_compare(f"error {split} − train_20", more["error"], one["error"]))
+        parts.append(f"{split}: error {more['error']}")
+    return comparisons, "mean score over the tests faster than 20 mm/s minus the score at 20 mm/s: " + "; ".join(parts)
+
+
+def _rotation_data(results: Results):
+    run = _data_efficiency(results)
+    sizes = _sizes(run)
+    if len(sizes) < 2:
+        raise _Missing("needs two training sizes")
+    models = ("neural", "hybrid", "error")
+    gains = {}
+    for metric in ("trans_percent", "rot_percent"):
+        small = _need(cells(run, metric, kind="trained", train_size=sizes[0]), models)
+        large = _need(cells(run, metric, kind="trained", train_size=sizes[-1]), models)
+        gains[metric] = {model: statistics.difference(small[model], large[model]) for model in models}
+    comparisons = [_compare(f"{model}: translation gain − rotation gain", gains["trans_percent"][model],
+                            gains["rot_percent"][model]) for model in models]
+    return comparisons, (f"points of % of zero gained from {sizes[0]} to {sizes[-1]} examples: " + "; ".join(
+        f"{model} translation {gains['trans_percent'][model]}, rotation {gains['rot_percent'][model]}"
+        for model in models))
 
 
 def _new_pushes(results: Results):
@@ -231,17 +401,56 @@ def _unseen_objects(results: Results):
     return comparisons, "rotation error [%]: " + "; ".join(parts)
 
 
+def view_cost(top_down: Mapping, free: Mapping, metric: str = "trans_percent", model: str = "hybrid") -> dict:
+    """What the free camera costs `model` (Sec. V), compared on each view's own test split against physics.
+
+    The two views are tested on different splits (``data_efficiency`` and ``viewpoint``), so each view's error is
+    first taken against the physics baseline on the same sequences (a paired bootstrap), and the cost is the
+    difference of those two: (free − physics on free's split) − (top-down − physics on top-down's split), their
+    standard errors combined as independent. Both at each run's largest training size.
+
+    Returns:
+      {"top_down": Estimate, "free": Estimate (model − physics on each split), "cost": Estimate, "sizes": (top, free)}.
+    """
+    against = {}
+    sizes = []
+    for name, run in (("top_down", top_down), ("free", free)):
+        size = _sizes(run)[-1]
+        trained = _need(cells(run, metric, kind="trained", train_size=size), (model,))
+        baseline = _need(cells(run, metric, kind="baseline"), ("physics",))
+        against[name] = statistics.difference(trained[model], baseline["physics"])
+        sizes.append(size)
+    return {**against, "cost": statistics.difference(against["free"], against["top_down"]), "sizes": tuple(sizes)}
+
+
+_DATA_EFFICIENCY = "|".join(DATA_EFFICIENCY_RUNS)
+
 CHECKS: dict[str, tuple[str, str, Callable[[Results], tuple[list[Comparison], str]]]] = {
     "small_data": ("With 2.5 k training examples, hybrid and error beat neural and simple clearly (Table 1).",
-                   "data_efficiency", _small_data),
+                   _DATA_EFFICIENCY, _small_data),
     "most_data": ("With the most training data, neural is best (Table 1: 17.4 / 33.4 % at 190 k).",
-                  "data_efficiency", _most_data),
+                  _DATA_EFFICIENCY, _most_data),
+    "crossover": ("With enough data, neural overtakes hybrid (Table 1: hybrid better at 2.5 k, neural at 190 k); "
+                  "where it crosses, with its sequence-bootstrap interval.", _DATA_EFFICIENCY, _crossover),
+    "hybrid_first": ("It takes more than 20 k training examples for the other models (neural, simple, neural_dyn) "
+                     "to reach hybrid: hybrid beats them at every size up to 20 k (Table 1).", _DATA_EFFICIENCY,
+                     _hybrid_first),
+    "only_neural_error": ("With the full training set only neural and error improve on physics; hybrid, simple and "
+                          "neural_dyn do not (Table 1).", _DATA_EFFICIENCY, _only_neural_error),
+    "neural_dyn": ("neural_dyn is worse than neural on the full training set (Table 1).", _DATA_EFFICIENCY,
+                   _neural_dyn),
+    "rotation_data": ("Rotation needs more data than translation: from 2.5 k to the full set neural, hybrid and "
+                      "error gain more points (% of zero) in rotation than in translation (Table 1).",
+                      _DATA_EFFICIENCY, _rotation_data),
     "new_pushes": ("On new pushes (held-out angles and contact points), hybrid and error beat neural (Table 3).",
                    "new_pushes", _new_pushes),
     "extrapolation": ("Trained at 20 mm/s, hybrid is the most constant over velocities; neural and neural_dyn "
                       "degrade at higher velocities (Fig. 6).", "velocities", _extrapolation),
     "faster_training": ("Adding 50 mm/s to training improves extrapolation for all models (Fig. 6).",
                         "velocities", _faster_training),
+    "error_velocities": ("error extrapolates well only when trained on more than one velocity: trained at 20 mm/s "
+                         "it degrades more than hybrid, trained on two velocities it degrades less than at 20 mm/s "
+                         "alone (Fig. 6).", "velocities", _error_velocities),
     "wrong_l": ("With a wrong l (× 1.5, × 3), error compensates better than hybrid (Table 5).", "error_variants",
                 _wrong_l),
     "error_grad": ("Trained at 20 mm/s, error_grad extrapolates worse than neural (Fig. 9).", "error_velocities",
@@ -251,15 +460,30 @@ CHECKS: dict[str, tuple[str, str, Callable[[Results], tuple[list[Comparison], st
     "unseen_objects": ("neural is consistently worse than the others at predicting the rotation of unseen "
                        "objects (Fig. 7).", "objects", _unseen_objects),
 }
-"""key -> (the paper's finding, the binary whose results decide it, the comparisons it makes)."""
+"""key -> (the paper's finding, the binary whose results decide it (alternatives joined by ``|``, the first present
+is read), the comparisons it makes)."""
+
+FULL_SET_CHECKS = frozenset({"most_data", "crossover", "only_neural_error", "neural_dyn", "rotation_data"})
+"""The findings whose condition is the paper's full training set: "not reached at N" below `FULL_SET_MIN`."""
+
+
+def _verdict(key: str, comparisons: Sequence[Comparison], results: Results, experiment: str) -> str:
+    verdict = _decide(comparisons)
+    if key in FULL_SET_CHECKS and verdict != HOLDS:
+        largest = _sizes(results[experiment])[-1]
+        if largest < FULL_SET_MIN:
+            return NOT_REACHED.format(size=largest)
+    return verdict
 
 
 def check(results: Results) -> list[Finding]:
     """Every finding of `CHECKS` decided on `results` (binary name -> results.json contents)."""
     findings = []
-    for key, (statement, experiment, comparisons_of) in CHECKS.items():
-        if experiment not in results:
-            findings.append(Finding(key, statement, experiment, UNCHECKED, f"no {experiment} results"))
+    for key, (statement, experiments, comparisons_of) in CHECKS.items():
+        experiment = _choose(results, experiments.split("|"))
+        if experiment is None:
+            findings.append(Finding(key, statement, experiments.split("|")[-1], UNCHECKED,
+                                    f"no {' or '.join(experiments.split('|'))} results"))
             continue
         try:
             comparisons, evidence = comparisons_of(results)
@@ -267,7 +491,7 @@ def check(results: Results) -> list[Finding]:
             findings.append(Finding(key, statement, experiment, UNCHECKED, str(missing)))
             continue
         evidence += "; differences (better − worse, ± s.e.): " + ", ".join(map(str, comparisons))
-        findings.append(Finding(key, statement, experiment, _decide(comparisons), evidence))
+        findings.append(Finding(key, statement, experiment, _verdict(key, comparisons, results, experiment), evidence))
     return findings
 
 
@@ -288,7 +512,9 @@ def load(workdirs: Sequence[str | os.PathLike]) -> dict[str, dict]:
 def markdown(findings: Sequence[Finding]) -> str:
     """The findings as a markdown table."""
     lines = [f"Decided at {MARGIN:g} standard error of the difference ({CLEAR_MARGIN:g} for \"clearly\"); scores are "
-             "the mean of trans. and rot. in % of zero, ± s.e. (sequence bootstrap and seed spread).", "",
+             "the mean of trans. and rot. in % of zero, ± s.e. (sequence bootstrap and seed spread); \"not reached at N\": "
+             f"a finding about the paper's full set (190 k) that does not hold at our largest size N < {FULL_SET_MIN}.",
+             "",
              "| finding (the paper's) | experiment | on our testbed | evidence |", "|---|---|---|---|"]
     lines += [f"| {f.statement} | {f.experiment} | {f.verdict} | {f.evidence} |" for f in findings]
     return "\n".join(lines)

@@ -20,6 +20,7 @@ ENVIRONMENT_VARIABLE = "PUSHJAX_PAPER_TABLES"
 _BESIDE_REPOSITORY = Path(__file__).resolve().parents[3] / "shared" / "data" / "paper_tables.json"
 
 _SIZED_TABLES = {"data_efficiency": ("table1_data_efficiency", "190000"),
+                 "data_efficiency_full": ("table1_data_efficiency", "190000"),
                  "new_pushes": ("table3_new_pushes", "114000")}
 _TEXT = {"velocities": ("fig6_velocities", "text"), "objects": ("fig7_objects", "text"),
          "error_velocities": ("table4_error_variants_190k", "fig9_text")}
@@ -56,7 +57,7 @@ def _entry(experiment: str, model: str, size_role: str | None, l_scale: float) -
         if model in ("physics", "zero"):
             return table.get(model)
         entry = table.get({"small": "2500", "largest": largest}.get(size_role, ""), {}).get(model)
-        if experiment == "data_efficiency" and size_role == "largest":  # Table 2: the state errors at 190 k
+        if experiment in ("data_efficiency", "data_efficiency_full") and size_role == "largest":  # Table 2: the state errors at 190 k
             entry = {**(entry or {}), **paper.get("table2_state_errors_190k", {}).get(model, {})} or None
         return entry
     if experiment == "error_variants":

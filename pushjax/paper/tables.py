@@ -12,6 +12,8 @@ import os
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
+import numpy as np
+
 from pushjax.paper import reference, statistics
 
 GROUP_KEYS = ("model", "kind", "train_split", "test_split", "train_size", "l_scale")
@@ -182,7 +184,7 @@ def markdown(results: Mapping) -> str:
                   f"our largest training size ({max(sizes, default='–')}) stands for the paper's largest.\n\n")
     overall = ("trans_percent", "rot_percent", "pos_mm")
     errors = ("trans_percent", "rot_percent")
-    if name == "data_efficiency":
+    if name in ("data_efficiency", "data_efficiency_full"):
         largest = [row for row in trained if row["train_size"] == _largest_size(trained)]
         return title + "\n\n".join([
             "## Table 1: errors by training-set size\n\n"
@@ -191,6 +193,8 @@ def markdown(results: Mapping) -> str:
             + metrics_table(largest, ["model"], STATE_METRICS, paper=_paper_cells(name, sizes, STATE_METRICS)),
             *([f"## Learning curves at {_largest_size(trained)} training examples\n\n"
                + curves_table(results["curves"], _largest_size(trained))] if results.get("curves") else []),
+            *([convergence_table(trained, results["config"].get("criterion"))]
+              if any("converged" in row for row in trained) else []),
         ]) + "\n"
     if name in ("velocities", "error_velocities", "objects"):
         figure = {"velocities": "Fig. 6", "error_velocities": "Fig. 9", "objects": "Fig. 7"}[name]
@@ -211,6 +215,32 @@ def markdown(results: Mapping) -> str:
                "visualize": "Errors on the repeated push (Figs. 7-8)"}
     return title + f"## {heading.get(name, name)}\n\n" + metrics_table(
         rows, ["model", "train_size", "test_split"], overall, paper=_paper_cells(name, sizes, overall)) + "\n"
+
+
+def convergence_table(trained: Sequence[Mapping], criterion: Mapping | None) -> str:
+    """Per model and size: how many seeds met the convergence criterion and the steps they took (issue 30)."""
+    rule = ""
+    if criterion:
+        rule = (f" The criterion: the best validation score of the last {criterion['window']} evaluations (one every "
+                f"{criterion['eval_every']} steps) not better by more than {criterion['min_improvement']:.0%} than the "
+                f"best before them; \"budget\": the constant-rate budget ended first.")
+    sizes = sorted({row["train_size"] for row in trained})
+    models = list(dict.fromkeys(row["model"] for row in trained))
+    lines = ["## Convergence: criterion met per model\n", "Seeds that met the criterion / seeds, and the mean steps "
+             "(constant rate + decay)." + rule, "", "| model | " + " | ".join(map(str, sizes)) + " |",
+             "|---|" + "---:|" * len(sizes)]
+    for model in models:
+        cells = []
+        for size in sizes:
+            members = [row for row in trained if row["model"] == model and row["train_size"] == size]
+            if not members:
+                cells.append("")
+                continue
+            met = sum(bool(row.get("converged")) for row in members)
+            steps = np.mean([row["steps"] for row in members])
+            cells.append(f"{met}/{len(members)} met, {steps:,.0f} steps")
+        lines.append(f"| {model} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
 
 
 def write(results: Mapping, workdir: str | os.PathLike) -> Path:

@@ -78,6 +78,10 @@ SEQUENCE_RATIOS = {
     "trans_percent": ("trans_mm", "trans_zero_mm", 100.0),
     "rot_percent": ("rot_deg", "rot_zero_deg", 100.0),
     "pos_mm": ("pos_mm", "count", 1.0),
+    "contact_mm": ("contact_mm", "contact_count", 1.0),
+    "normal_deg": ("normal_deg", "normal_count", 1.0),
+    "s": ("s", "count", 1.0),
+    "push_velocity_deg": ("push_velocity_deg", "push_velocity_count", 1.0),
 }
 """metric -> (numerator, denominator, factor): the metric is factor * sum(numerator) / sum(denominator) over the
 per-sequence sums of ``sequences`` (so a resample of the sequences gives a bootstrap replicate of it)."""
@@ -133,9 +137,12 @@ def error_metrics(predictions: Mapping[str, np.ndarray], examples: Examples) -> 
 
     Returns:
       {metric: float} as in the module docstring, and with ``sequence_id`` also ``sequences``: {"id", "count",
-      "trans_mm", "rot_deg", "trans_zero_mm", "rot_zero_deg" and with ``object_pos`` "pos_mm"}, each a list of
-      per-sequence sums over the S sequences (mm, degrees); then ``trans_percent_se``, ``rot_percent_se`` and
-      ``pos_mm_se`` are sequence-bootstrap standard errors (`bootstrap_replicates`).
+      "trans_mm", "rot_deg", "trans_zero_mm", "rot_zero_deg", with ``object_pos`` "pos_mm", and for each state
+      metric the model predicts its sum and the count of the examples it is defined on ("contact_mm" and
+      "contact_count", "normal_deg" and "normal_count", "s", "push_velocity_deg" and "push_velocity_count")}, each a
+      list of per-sequence sums over the S sequences (mm, degrees); then every metric of `SEQUENCE_RATIOS` it has
+      gets a sequence-bootstrap standard error ``<metric>_se`` (`bootstrap_replicates`); without, state metrics'
+      ``_se`` treat the examples as independent.
     """
     true_motion = np.asarray(examples["motion"], np.float64)
     motion = np.asarray(predictions["motion"], np.float64)
@@ -158,25 +165,18 @@ def error_metrics(predictions: Mapping[str, np.ndarray], examples: Examples) -> 
     if "object_pos" in predictions:
         per_example["pos_mm"] = np.linalg.norm(predictions["object_pos"] - examples["object_pos"], axis=-1) * planar.M_TO_MM
         metrics["pos_mm"], metrics["pos_mm_se"] = _mean_and_se(per_example["pos_mm"])
-    if "sequence_id" in examples:
-        sequences = _sequence_sums(examples["sequence_id"], **per_example)
-        if len(sequences["id"]) > 1:
-            for metric in SEQUENCE_RATIOS:
-                if f"{metric}_se" in metrics:
-                    metrics[f"{metric}_se"] = float(bootstrap_replicates(sequences, metric).std(ddof=1))
-        metrics["sequences"] = sequences
     touching = np.asarray(examples["contact_flag"]) > 0.5
+    state_errors = {}  # metric -> ([N] per-example error, [N] bool: the example counts)
     if "contact" in predictions:
-        metrics["contact_mm"], _ = _mean_and_se(
-            np.linalg.norm(predictions["contact"] - examples["contact"], axis=-1)[touching] * planar.M_TO_MM
-        )
+        state_errors["contact_mm"] = (
+            np.linalg.norm(predictions["contact"] - examples["contact"], axis=-1) * planar.M_TO_MM, touching)
     if "normal" in predictions:
         valid = touching & (np.linalg.norm(predictions["normal"], axis=-1) > 0)
-        metrics["normal_deg"], _ = _mean_and_se(
-            _angle_deg(predictions["normal"][valid], examples["normal"][valid])
-        )
+        angles = np.zeros(len(motion))
+        angles[valid] = _angle_deg(predictions["normal"][valid], examples["normal"][valid])
+        state_errors["normal_deg"] = (angles, valid)
     if "s" in predictions:
-        metrics["s"], _ = _mean_and_se(np.abs(predictions["s"] - examples["contact_flag"]))
+        state_errors["s"] = (np.abs(predictions["s"] - examples["contact_flag"]), np.ones(len(motion), bool))
     push_velocity = predictions.get("push_velocity")
     if push_velocity is None and "normal" in predictions:
         push_velocity = np.asarray(lynch.effective_push_velocity(
@@ -189,9 +189,22 @@ def error_metrics(predictions: Mapping[str, np.ndarray], examples: Examples) -> 
             & (np.linalg.norm(push_velocity, axis=-1) > 0)
             & (np.linalg.norm(true_push_velocity, axis=-1) > 0)
         )
-        metrics["push_velocity_deg"], _ = _mean_and_se(
-            _angle_deg(push_velocity[valid], true_push_velocity[valid])
-        )
+        angles = np.zeros(len(motion))
+        angles[valid] = _angle_deg(push_velocity[valid], true_push_velocity[valid])
+        state_errors["push_velocity_deg"] = (angles, valid)
+    for name, (error, valid) in state_errors.items():
+        metrics[name], metrics[f"{name}_se"] = _mean_and_se(np.asarray(error, np.float64)[valid])
+        per_example[name] = np.where(valid, error, 0.0)
+        if SEQUENCE_RATIOS[name][1] != "count":
+            per_example[SEQUENCE_RATIOS[name][1]] = valid.astype(np.float64)
+    if "sequence_id" in examples:
+        sequences = _sequence_sums(examples["sequence_id"], **per_example)
+        if len(sequences["id"]) > 1:
+            for metric in SEQUENCE_RATIOS:
+                if f"{metric}_se" in metrics:
+                    with np.errstate(divide="ignore", invalid="ignore"):
+                        metrics[f"{metric}_se"] = float(bootstrap_replicates(sequences, metric).std(ddof=1))
+        metrics["sequences"] = sequences
     return metrics
 
 

@@ -287,3 +287,19 @@ def test_paper_scale_sizes():
     cpu = configs.get_config("data_efficiency", "cpu")
     plan = configs.plan_splits(cpu, "/unused")
     assert len(plan.splits["train"]) * cpu.examples_per_sequence == pytest.approx(20e3, rel=0.05)
+
+
+def test_cpu_full_has_the_papers_composition():
+    config = configs.get_config("data_efficiency", "cpu_full")
+    plan = configs.plan_splits(config, "/unused")
+    sizes = {name: len(ids) * config.examples_per_sequence for name, ids in plan.splits.items()}
+    assert sizes == {"train": 190_080, "validation": 6_336, "test": 38_016}
+    assert len(plan.splits["test"]) >= 500 and (config.image_size, config.glimpse_size) == (64, 20)
+    jobs = [plan.jobs[i] for ids in plan.splits.values() for i in ids]
+    assert {job.params.surface for job in jobs} == {"abs", "delrin", "plywood", "pu"}
+    assert {job.params.shape for job in jobs} == set(configs.OBJECT_NAMES)
+    assert {(job.params.velocity, job.params.acceleration) for job in jobs} == {(20.0, 0.0)}
+    test = {i for i in plan.splits["test"]}
+    assert not test & set(plan.splits["train"]) and not test & set(plan.splits["validation"])
+    # every surface in the test split
+    assert {plan.jobs[i].params.surface for i in test} == {"abs", "delrin", "plywood", "pu"}

@@ -12,8 +12,11 @@ from absl import flags
 from tests.conftest import once_across_workers
 
 SMOKE = ("--scale=smoke", "--num_steps=2")
+TINY_CRITERION = "--criterion=eval_every=5;window=2;base_steps=10;steps_per_example=0;max_steps=10;min_decay_steps=2"
 RUNS = {
     # binary: (datasets it reads, its flags besides SMOKE, --workdir and --data_dir)
+    "data_efficiency_full": (("data_efficiency",), ("--sizes=40,80", "--side_sizes=80", "--seeds=0", "--nowide",
+                                                    TINY_CRITERION)),
     "data_efficiency": (("data_efficiency",), ("--sizes=20,1000000", "--variants=hybrid,neural_dyn,zero,physics")),
     "new_pushes": (("new_pushes",), ("--sizes=50", "--variants=hybrid,zero")),
     "velocities": (("velocities",), ("--variants=hybrid,physics",)),

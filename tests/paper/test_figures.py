@@ -1,5 +1,7 @@
 """The figures' legends name every line they draw."""
 
+import json
+
 import pytest
 
 from pushjax.paper import figures
@@ -31,3 +33,21 @@ def test_learning_curves_name_the_training_split_and_l_where_they_vary(train_spl
                                                                         monkeypatch):
     legend = _legend_of_curves_figure(_curve_rows(train_splits, l_scales, sizes=(100, 1000)), tmp_path, monkeypatch)
     assert sorted(legend) == sorted(expected)
+
+
+def test_fig5_of_the_full_run_shows_the_papers_end_points(tmp_path, monkeypatch):
+    tables_file = tmp_path / "paper_tables.json"
+    tables_file.write_text(json.dumps({"table1_data_efficiency": {
+        "2500": {"neural": {"trans": [33.6, 0.2], "rot": [62.5, 0.4]}},
+        "190000": {"neural": {"trans": [17.4, 0.1], "rot": [33.4, 0.3]}}}}))
+    monkeypatch.setenv("PUSHJAX_PAPER_TABLES", str(tables_file))
+    assert figures.paper_table1_points() == {"neural": [(2500.0, {"trans_percent": 33.6, "rot_percent": 62.5}),
+                                                        (190000.0, {"trans_percent": 17.4, "rot_percent": 33.4})]}
+    rows = [{"model": "neural", "kind": "trained", "train_split": "train", "test_split": "test", "train_size": size,
+             "seed": 0, "l_scale": 1.0, "trans_percent": 30.0, "rot_percent": 50.0} for size in (2500, 20000)]
+    drawn = []
+    monkeypatch.setattr(figures.plt, "close", drawn.append)
+    figures.plot({"name": "data_efficiency_full", "rows": rows}, tmp_path)
+    labels = drawn[0].axes[0].get_legend_handles_labels()[1]
+    assert sorted(labels) == ["neural", "neural (paper)"]
+    assert sorted(tick.get_text() for tick in drawn[0].axes[0].get_xticklabels()) == ["190,000", "2,500", "20,000"]

@@ -1,0 +1,241 @@
+"""Table 1 at the paper's composition and sizes (issue 30): one model at a time, each recorded as it finishes.
+
+The run ``data_efficiency_full`` trains on the ``data_efficiency`` dataset at ``cpu_full`` scale (all objects on all
+four surfaces at 20 mm/s, 190 080 training and 38 016 test examples from 528 test sequences, 64 x 64 images):
+neural, hybrid and error at every size of `SIZES`, simple and neural_dyn at `SIDE_SIZES`, seeds `SEEDS` (a different
+training subset per seed; at the full split every seed trains on the same examples, with its own initialisation and
+batch order), and `WIDE_VARIANTS` once at the paper's widths at the full split. Each model trains by the convergence
+criterion of `pushjax.train.convergence` (constant rate until its validation score stops improving, within a budget
+growing with the size, then a short decay).
+
+A unit of work is one model. When it is trained and evaluated, its record -- the test row of ``results.json``
+(per-sequence sums included, for the bootstrap), the criterion's verdict, its steps and validation curve -- is written
+to ``<workdir>/models/<key>.json`` (a few tens of KiB), and ``results.json``, ``results.md`` and the figures are
+assembled again from every record present. A later run with the same work directory skips every model that has a
+record, so the run resumes across sittings and fresh checkouts as long as the records are kept (committed); a
+model interrupted before its record is written is trained again from the start. The dataset is rebuilt from its
+seed when missing.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime
+import json
+import math
+import time
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+
+import jax
+import numpy as np
+
+from pushjax import train as train_lib
+from pushjax.models import ModelConfig
+from pushjax.paper import runner, spec as spec_lib
+from pushjax.train import convergence, evaluate
+
+NAME = "data_efficiency_full"
+FULL = 190_080
+"""The training split of ``data_efficiency`` at ``cpu_full`` scale, examples."""
+SIZES = (2_500, 5_000, 10_000, 20_000, 50_000, 100_000, FULL)
+SIDE_SIZES = (2_500, 20_000, FULL)
+SEEDS = (0, 1, 2)
+MAIN_VARIANTS = ("neural", "hybrid", "error")
+SIDE_VARIANTS = ("simple", "neural_dyn")
+WIDE_VARIANTS = ("neural", "hybrid")
+"""Trained once (seed 0) at the full split with the paper's widths (`pushjax.models.ModelConfig`'s defaults)."""
+SCALE = "cpu_full"
+
+
+@dataclasses.dataclass(frozen=True)
+class Unit:
+    """One model of the run."""
+
+    variant: str
+    size: int
+    seed: int
+    wide: bool = False
+
+    @property
+    def key(self) -> str:
+        return f"{self.variant}_{self.size}_seed{self.seed}" + ("_wide" if self.wide else "")
+
+    @property
+    def model(self) -> str:
+        """The model's name in ``results.json``: the variant, ``_wide`` for the paper's widths."""
+        return self.variant + ("_wide" if self.wide else "")
+
+
+def plan(sizes: Sequence[int] = SIZES, seeds: Sequence[int] = SEEDS, side_sizes: Sequence[int] = SIDE_SIZES,
+         wide: bool = True) -> list[Unit]:
+    """Every model of the run in the order it trains: by size, then variant, then seed; the wide models last."""
+    units = []
+    for size in sizes:
+        variants = MAIN_VARIANTS + (SIDE_VARIANTS if size in side_sizes else ())
+        units += [Unit(variant, size, seed) for variant in variants for seed in seeds]
+    if wide:
+        units += [Unit(variant, max(sizes), seeds[0], wide=True) for variant in WIDE_VARIANTS]
+    return units
+
+
+def setup(sizes: Sequence[int] = SIZES) -> spec_lib.Setup:
+    return spec_lib.Setup(NAME, "data_efficiency", (*MAIN_VARIANTS, *SIDE_VARIANTS, "zero", "physics"),
+                          sizes=tuple(sizes))
+
+
+def make_spec(data_dir: str | None = None, *, sizes: Sequence[int] = SIZES, seeds: Sequence[int] = SEEDS,
+              scale: str = SCALE, build: bool = True, workers: int | None = None) -> spec_lib.ExperimentSpec:
+    """The run's `ExperimentSpec` (``sequential`` mode: one model at a time on the CPU)."""
+    return spec_lib.make_spec(setup(sizes), scale, sizes=sizes, seeds=seeds, data_dir=data_dir, build=build,
+                              workers=workers, mode="sequential")
+
+
+def _compact(value):
+    """Floats of nested lists and dicts rounded to 7 significant digits (records stay small and diff well)."""
+    if isinstance(value, float):
+        return value if not math.isfinite(value) else float(f"{value:.7g}")
+    if isinstance(value, dict):
+        return {key: _compact(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_compact(item) for item in value]
+    return value
+
+
+def _write_json(path: Path, contents) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(path.name + ".partial")
+    partial.write_text(json.dumps(contents, indent=1) + "\n")
+    partial.replace(path)
+
+
+def records(workdir: str | Path) -> dict[str, dict]:
+    """key -> record of every finished model in ``<workdir>/models``."""
+    folder = Path(workdir) / "models"
+    return {path.stem: json.loads(path.read_text()) for path in sorted(folder.glob("*.json"))}
+
+
+def train_config(spec: spec_lib.ExperimentSpec, unit: Unit) -> train_lib.TrainConfig:
+    config = spec.train_config(unit.variant)
+    if unit.wide:
+        model = dataclasses.replace(ModelConfig(), variant=unit.variant, view=config.model.view,
+                                    glimpse_size=config.model.glimpse_size)
+        config = dataclasses.replace(config, model=model)
+    return config
+
+
+def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Mapping, validation: Mapping,
+               test: Mapping, criterion: convergence.Criterion = convergence.CRITERION,
+               log: Callable[[str], None] | None = None) -> dict:
+    """Trains and evaluates one model; returns its record."""
+    count = len(train_examples["motion"])
+    size = min(unit.size, count)
+    (model_spec,) = train_lib.subset_specs(count, (size,), (unit.seed,))
+    config = train_config(spec, unit)
+    started = datetime.datetime.now(datetime.timezone.utc)
+    trained = convergence.train_until_converged(config, train_examples, model_spec, validation, criterion, log=log)
+    clock = time.monotonic()
+    metrics = evaluate.evaluate(trained.model, trained.state, test, config.eval_batch_size)
+    row = {"model": unit.model, "kind": "trained", "train_split": "train", "test_split": "test",
+           "train_size": size, "seed": unit.seed, "l_scale": 1.0, "steps": trained.steps,
+           "converged": trained.converged, "constant_steps": trained.constant_steps,
+           "decay_steps": trained.decay_steps, **metrics}
+    return _compact({
+        "key": unit.key, "unit": dataclasses.asdict(unit), "row": runner.finite_or_none(row),
+        "validation": [{"step": step, "trans_percent": trans, "rot_percent": rot}
+                       for step, trans, rot in trained.validation],
+        "criterion": dataclasses.asdict(criterion), "budget": criterion.budget(size),
+        "parameters": int(sum(np.size(leaf) for leaf in jax.tree.leaves(trained.state.params))),
+        "train_seconds": round(trained.seconds, 1), "eval_seconds": round(time.monotonic() - clock, 1),
+        "steps_per_second": trained.steps_per_second, "started": started.isoformat(timespec="seconds"),
+        "commit": runner._git_commit(),
+    })
+
+
+def baseline_rows(spec: spec_lib.ExperimentSpec, test: Mapping) -> list[dict]:
+    return [runner.finite_or_none(row) for row in runner._baseline_rows(spec, {"test": test}, 1.0)]
+
+
+def assemble(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit],
+             criterion: convergence.Criterion = convergence.CRITERION) -> dict:
+    """``results.json`` from the baselines and every finished model's record (schema of `pushjax.paper.runner`;
+    trained rows carry ``converged``, ``constant_steps`` and ``decay_steps``; ``curves`` are the validation
+    curves; ``progress`` says how many of the planned models are done)."""
+    workdir = Path(workdir)
+    done = records(workdir)
+    baselines = json.loads((workdir / "baselines.json").read_text())
+    rows = baselines + [record["row"] for key, record in done.items()]
+    curves = [{"model": record["row"]["model"], "train_split": "train", "train_size": record["row"]["train_size"],
+               "seed": record["row"]["seed"], "l_scale": 1.0, "step": point["step"], "split": "validation",
+               "trans_percent": point["trans_percent"], "rot_percent": point["rot_percent"]}
+              for record in done.values() for point in record["validation"]]
+    config = spec.to_json()
+    config["criterion"] = dataclasses.asdict(criterion)
+    config["planned_models"] = [unit.key for unit in units]
+    train_seconds = sum(record["train_seconds"] + record["eval_seconds"] for record in done.values())
+    return {"name": NAME, "config": config, "rows": rows, "curves": curves,
+            "progress": {"planned": len(units), "done": sum(unit.key in done for unit in units),
+                         "missing": [unit.key for unit in units if unit.key not in done]},
+            "provenance": {"commit": runner._git_commit(), "model_seconds": round(train_seconds, 1)}}
+
+
+def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit], *,
+        max_models: int | None = None, deadline: datetime.datetime | None = None,
+        criterion: convergence.Criterion = convergence.CRITERION, progress: bool = True,
+        publish: Callable[[dict], None] | None = None, log: Callable[[str], None] = print) -> dict:
+    """Trains the `units` that have no record in `workdir`, in order, writing each record when it is done.
+
+    Args:
+      spec: `make_spec`.
+      workdir: the records (``models/``), ``baselines.json`` and ``results.json``.
+      units: `plan`.
+      max_models: train at most this many models in this call (None: all).
+      deadline: start no model after this time (UTC).
+      criterion: the convergence criterion.
+      progress: progress bars of the dataset build.
+      publish: called with ``results.json``'s contents after it is written (e.g. tables and figures).
+      log: progress lines.
+    """
+    workdir = Path(workdir)
+    fields = spec.example_fields()
+    splits = runner.load_splits(spec, spec.dataset, progress)
+    test = train_lib.examples_from_source(splits["test"], fields)
+    if not (workdir / "baselines.json").exists():
+        _write_json(workdir / "baselines.json", _compact(baseline_rows(spec, test)))
+    todo = [unit for unit in units if unit.key not in records(workdir)]
+    log(f"{NAME}: {len(units) - len(todo)} of {len(units)} models recorded in {workdir}/models, {len(todo)} to train")
+    trained = 0
+    if todo and (max_models is None or max_models > 0):
+        validation = train_lib.examples_from_source(splits["validation"], fields)
+        clock = time.monotonic()
+        train_examples = train_lib.examples_from_source(splits["train"], fields)
+        log(f"{NAME}: read {len(train_examples['motion'])} training examples in {time.monotonic() - clock:.0f} s")
+        for unit in todo:
+            if max_models is not None and trained >= max_models:
+                break
+            if deadline is not None and datetime.datetime.now(datetime.timezone.utc) >= deadline:
+                log(f"{NAME}: deadline {deadline.isoformat(timespec='minutes')} passed; stopping before {unit.key}")
+                break
+            log(f"{NAME}: training {unit.key} (budget {criterion.budget(min(unit.size, len(train_examples['motion'])))}"
+                " constant-rate steps)")
+            record = train_unit(spec, unit, train_examples, validation, test, criterion, log)
+            _write_json(workdir / "models" / f"{unit.key}.json", record)
+            trained += 1
+            row = record["row"]
+            log(f"{NAME}: recorded {unit.key}: {row['steps']} steps ({'converged' if row['converged'] else 'budget'}"
+                f"), test trans {row['trans_percent']:.1f} % rot {row['rot_percent']:.1f} %, "
+                f"{record['train_seconds']:.0f} s at {record['steps_per_second']:.1f} steps/s")
+            results = write_results(spec, workdir, units, criterion)
+            if publish is not None:
+                publish(results)
+    results = write_results(spec, workdir, units, criterion)
+    if publish is not None:
+        publish(results)
+    return results
+
+
+def write_results(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit],
+                  criterion: convergence.Criterion = convergence.CRITERION) -> dict:
+    results = assemble(spec, workdir, units, criterion)
+    _write_json(Path(workdir) / "results.json", results)
+    return results

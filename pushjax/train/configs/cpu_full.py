@@ -1,0 +1,16 @@
+"""``cpu_full`` scale (issue 30): the ``cpu`` architecture, trained by a convergence criterion.
+
+Adam at a constant 10^-3 until the validation score stops improving (`pushjax.train.convergence.CRITERION`), then a
+short cosine decay to 10^-5; `num_steps` is the budget's cap at the full split (the criterion's budget grows with the
+training-set size). `pushjax.paper.full_run` trains with `pushjax.train.convergence.train_until_converged`.
+"""
+
+import dataclasses
+
+from pushjax.train.configs import TrainConfig
+from pushjax.train.configs import cpu
+
+
+def get_config() -> TrainConfig:
+    return dataclasses.replace(cpu.get_config(), schedule="constant", learning_rate=1e-3, num_steps=60_000,
+                               checkpoint_every=1_000)

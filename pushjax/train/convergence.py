@@ -1,0 +1,203 @@
+"""Training one model until a convergence criterion on its validation score is met (issue 30).
+
+The published runs train for a fixed number of steps with a cosine decay, whose end makes every learning curve look
+flat. `train_until_converged` instead trains one model at a constant learning rate and scores it on a fixed
+validation set every `Criterion.eval_every` steps; the score is the findings' (`pushjax.paper.statistics.SCORE`):
+the mean of the translation and rotation errors in % of the ``zero`` baseline.
+
+**The criterion** (fixed before the run it judges): the constant phase ends at the first evaluation at which the
+best score of the last `Criterion.window` evaluations is not better than the best score before them by more than
+`Criterion.min_improvement` (relative), i.e. the validation score has stopped improving for ``window *
+eval_every`` steps; the model is then *converged*. When the budget of constant steps (`Criterion.budget`, growing
+with the training-set size) ends first, the model is *not converged*. Either way a short cosine decay of the
+learning rate to `Criterion.final_lr_fraction` of it follows (`Criterion.decay_steps`: a tenth of the constant
+phase, at least `Criterion.min_decay_steps`), and the model after the decay is the one evaluated.
+
+One model per call: the unit of work of a resumable run whose finished models are recorded as they finish
+(`pushjax.paper.full_run`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable, Mapping, Sequence
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
+
+from pushjax.models import PushModel
+from pushjax.train.batching import Examples, ModelSpec, batch_indices, gather, model_fields
+from pushjax.train.configs import TrainConfig
+from pushjax.train.evaluate import error_metrics, predict
+from pushjax.train.train_state import TrainState, create_train_state, make_train_step
+
+
+@dataclasses.dataclass(frozen=True)
+class Criterion:
+    """When a model's constant-rate phase ends, and how long it may last.
+
+    Attributes:
+      eval_every: steps between validation scores.
+      window: evaluations without a relative improvement of more than `min_improvement` that end the phase.
+      min_improvement: relative improvement of the best validation score that counts (0.01: 1 %).
+      base_steps: the budget of constant-rate steps at size 0 ...
+      steps_per_example: ... plus this many per training example (`budget`).
+      max_steps: the budget's cap.
+      decay_fraction: the decay lasts this fraction of the constant phase ...
+      min_decay_steps: ... and at least this many steps.
+      final_lr_fraction: the learning rate at the end of the decay, as a fraction of the constant one.
+    """
+
+    eval_every: int = 1_000
+    window: int = 5
+    min_improvement: float = 0.01
+    base_steps: int = 10_000
+    steps_per_example: float = 0.25
+    max_steps: int = 60_000
+    decay_fraction: float = 0.1
+    min_decay_steps: int = 1_000
+    final_lr_fraction: float = 0.01
+
+    def __post_init__(self):
+        for name in ("eval_every", "window", "base_steps", "max_steps", "min_decay_steps"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name}: expected a positive integer, got {getattr(self, name)}")
+        for name in ("min_improvement", "decay_fraction", "final_lr_fraction"):
+            if not 0.0 <= getattr(self, name) < 1.0:
+                raise ValueError(f"{name}: expected a fraction in [0, 1), got {getattr(self, name)}")
+
+    def budget(self, size: int) -> int:
+        """The most constant-rate steps a model on `size` training examples takes (a multiple of `eval_every`)."""
+        steps = min(self.max_steps, self.base_steps + self.steps_per_example * size)
+        return max(self.eval_every, int(math.ceil(steps / self.eval_every)) * self.eval_every)
+
+    def plateaued(self, scores: Sequence[float]) -> bool:
+        """Whether validation `scores` (one per evaluation, lower is better) have stopped improving."""
+        if len(scores) <= self.window:
+            return False
+        before, recent = min(scores[:-self.window]), min(scores[-self.window:])
+        return recent > before * (1.0 - self.min_improvement)
+
+    def decay_steps(self, constant_steps: int) -> int:
+        return max(self.min_decay_steps, int(round(self.decay_fraction * constant_steps)))
+
+
+CRITERION = Criterion()
+"""The criterion of the ``data_efficiency_full`` run, fixed before it."""
+
+
+@dataclasses.dataclass(frozen=True)
+class ConvergedModel:
+    """Outcome of `train_until_converged`.
+
+    Attributes:
+      model: the Flax module.
+      state: the trained `TrainState` (after the decay).
+      converged: whether the criterion ended the constant phase (False: its budget did).
+      constant_steps: steps at the constant learning rate.
+      decay_steps: steps of the decay.
+      validation: [(step, trans_percent, rot_percent)] every validation evaluation (its score: their mean), the one
+        after the decay last.
+      seconds: wall time of the training and its validation scores.
+      steps_per_second: training steps per second (validation excluded).
+    """
+
+    model: PushModel
+    state: TrainState
+    converged: bool
+    constant_steps: int
+    decay_steps: int
+    validation: list[tuple[int, float, float]]
+    seconds: float
+    steps_per_second: float
+
+    @property
+    def steps(self) -> int:
+        return self.constant_steps + self.decay_steps
+
+
+def validation_errors(model: PushModel, state: TrainState, examples: Examples, batch_size: int) -> tuple[float, float]:
+    """The translation and rotation errors in % of zero of `state` on `examples`; their mean is the score."""
+    metrics = error_metrics(predict(model, state, examples, batch_size), examples)
+    return float(metrics["trans_percent"]), float(metrics["rot_percent"])
+
+
+def _with_learning_rate(state: TrainState, value: float) -> TrainState:
+    opt_state = state.opt_state
+    hyperparams = dict(opt_state.hyperparams, learning_rate=jnp.asarray(value, jnp.float32))
+    return state.replace(opt_state=opt_state._replace(hyperparams=hyperparams))
+
+
+def train_until_converged(
+    train_config: TrainConfig, examples: Examples, spec: ModelSpec, validation: Examples,
+    criterion: Criterion = CRITERION, *, physics: Callable | None = None,
+    log: Callable[[str], None] | None = None,
+) -> ConvergedModel:
+    """Trains one model (`train_config.model`, the subset and seed of `spec`) by `criterion`.
+
+    Args:
+      train_config: model, learning rate (the constant one), batch size, weight decay, evaluation batch size; its
+        `num_steps` and `schedule` are not used (the criterion sets them).
+      examples: the training split, {field: [N, ...]}.
+      spec: the model's training subset and seed (its batches as in `pushjax.train.sweep`).
+      validation: the examples of the validation score.
+      criterion: the convergence criterion and budget.
+      physics: replaces `PushModel.physics`.
+      log: called with a line after every validation score.
+    """
+    model = PushModel(train_config.model) if physics is None else PushModel(train_config.model, physics)
+    optimizer = optax.inject_hyperparams(optax.adam)(learning_rate=train_config.learning_rate)
+    fields = model_fields(train_config.model)
+    size = len(spec.train_indices)
+
+    def batch_at(step):
+        return gather(examples, batch_indices(spec, step, train_config.batch_size), fields)
+
+    state = create_train_state(model, optimizer, batch_at(0), spec.seed)
+    state = _with_learning_rate(state, train_config.learning_rate)
+    step_fn = jax.jit(make_train_step(model, optimizer, train_config.weight_decay))
+    budget = criterion.budget(size)
+    scores: list[float] = []
+    history: list[tuple[int, float, float]] = []
+    started, train_seconds = time.monotonic(), 0.0
+    step, converged = 0, False
+
+    def score_now(label: str) -> float:
+        trans, rot = validation_errors(model, state, validation, train_config.eval_batch_size)
+        score = (trans + rot) / 2.0
+        history.append((step, trans, rot))
+        if log is not None:
+            log(f"{spec.name}: step {step} ({label}) validation score {score:.2f}")
+        return score
+
+    while step < budget:
+        chunk = time.monotonic()
+        for _ in range(criterion.eval_every):
+            state, metrics = step_fn(state, batch_at(step))
+            step += 1
+        jax.block_until_ready(state.params)
+        train_seconds += time.monotonic() - chunk
+        scores.append(score_now("constant"))
+        if criterion.plateaued(scores):
+            converged = True
+            break
+    constant_steps = step
+    decay_steps = criterion.decay_steps(constant_steps)
+    lr = train_config.learning_rate
+    chunk = time.monotonic()
+    for index in range(decay_steps):
+        progress = (index + 1) / decay_steps
+        cosine = 0.5 * (1.0 + math.cos(math.pi * progress))
+        state = _with_learning_rate(state, lr * (criterion.final_lr_fraction + (1 - criterion.final_lr_fraction)
+                                                 * cosine))
+        state, metrics = step_fn(state, batch_at(step))
+        step += 1
+    jax.block_until_ready(state.params)
+    train_seconds += time.monotonic() - chunk
+    score_now("after the decay")
+    return ConvergedModel(model, state, converged, constant_steps, decay_steps, history,
+                          time.monotonic() - started, step / train_seconds if train_seconds > 0 else float("nan"))

@@ -1,0 +1,70 @@
+"""The paper-composition run (issue 30) on the smoke data: one model per unit, records, resuming."""
+
+import json
+import shutil
+
+import pytest
+from absl import app
+
+from pushjax.paper import findings, full_run
+from tests.paper.conftest import RUNS, SMOKE, run_binary
+
+
+def test_plan_covers_the_issue():
+    units = full_run.plan()
+    sizes = sorted({unit.size for unit in units if not unit.wide})
+    assert len(sizes) >= 7 and sizes[-1] >= 150_000 and len({unit.key for unit in units}) == len(units)
+    for size in sizes:
+        variants = {unit.variant for unit in units if unit.size == size and not unit.wide}
+        expected = {"neural", "hybrid", "error"} | ({"simple", "neural_dyn"} if size in full_run.SIDE_SIZES else set())
+        assert variants == expected
+        assert all({u.seed for u in units if u.size == size and u.variant == v} == {0, 1, 2} for v in variants)
+    assert [unit.key for unit in units if unit.wide] == ["neural_190080_seed0_wide", "hybrid_190080_seed0_wide"]
+
+
+def test_results_of_the_records(smoke_results):
+    workdir = smoke_results("data_efficiency_full")
+    results = json.loads((workdir / "results.json").read_text())
+    assert results["name"] == "data_efficiency_full" and results["progress"] == {"planned": 8, "done": 8, "missing": []}
+    trained = [row for row in results["rows"] if row["kind"] == "trained"]
+    assert sorted((row["model"], row["train_size"]) for row in trained) == sorted(
+        [(m, 40) for m in ("neural", "hybrid", "error")]
+        + [(m, 80) for m in ("neural", "hybrid", "error", "simple", "neural_dyn")])
+    # The tiny criterion's budget of 10 steps ends every model before the criterion can (2 scores, window 2).
+    assert all(row["converged"] is False and row["steps"] == 12 and row["sequences"]["id"] for row in trained)
+    assert {row["model"] for row in results["rows"] if row["kind"] == "baseline"} == {"zero", "physics"}
+    assert results["config"]["criterion"]["eval_every"] == 5
+    assert len(results["curves"]) == 3 * len(trained)  # steps 5, 10 and after the decay
+    markdown = (workdir / "results.md").read_text()
+    assert "## Convergence: criterion met per model" in markdown and "0/1 met, 12 steps" in markdown
+    keys = {finding.key: finding for finding in findings.check(findings.load([workdir]))}
+    assert keys["crossover"].experiment == "data_efficiency_full"
+
+
+def test_a_fresh_checkout_trains_only_the_missing_models(smoke_results, smoke_data, tmp_path):
+    workdir = tmp_path / "run"
+    shutil.copytree(smoke_results("data_efficiency_full"), workdir)
+    records = workdir / "models"
+    before = {path.name: path.read_text() for path in records.iterdir()}
+    (records / "hybrid_80_seed0.json").unlink()
+    (workdir / "results.json").unlink()
+    _, arguments = RUNS["data_efficiency_full"]
+    run_binary("data_efficiency_full", *SMOKE, f"--data_dir={smoke_data('data_efficiency')}", f"--workdir={workdir}",
+               *arguments, "--max_models=0")
+    results = json.loads((workdir / "results.json").read_text())
+    assert results["progress"]["missing"] == ["hybrid_80_seed0"]
+    run_binary("data_efficiency_full", *SMOKE, f"--data_dir={smoke_data('data_efficiency')}", f"--workdir={workdir}",
+               *arguments)
+    after = {path.name: path.read_text() for path in records.iterdir()}
+    assert set(after) == set(before)
+    assert all(after[name] == text for name, text in before.items() if name != "hybrid_80_seed0.json")
+    assert json.loads((workdir / "results.json").read_text())["progress"]["done"] == 8
+
+
+def test_bad_criterion_and_deadline(tmp_path):
+    with pytest.raises(app.UsageError, match="--criterion: unknown field 'patience'"):
+        run_binary("data_efficiency_full", f"--workdir={tmp_path}", "--criterion=patience=3")
+    with pytest.raises(app.UsageError, match="--criterion: window expects a int"):
+        run_binary("data_efficiency_full", f"--workdir={tmp_path}", "--criterion=window=x")
+    with pytest.raises(app.UsageError, match="--deadline"):
+        run_binary("data_efficiency_full", f"--workdir={tmp_path}", "--deadline=soon")

@@ -1,0 +1,46 @@
+"""The convergence criterion of issue 30's run, and one model trained by it on the smoke data."""
+
+import numpy as np
+import pytest
+
+from pushjax.train import convergence
+from pushjax.train.batching import ModelSpec
+from tests.tiny_configs import TINY_SMOKE
+
+
+def test_budget_grows_with_size_and_is_capped():
+    criterion = convergence.Criterion(eval_every=1000, base_steps=10_000, steps_per_example=0.25, max_steps=60_000)
+    budgets = [criterion.budget(size) for size in (2_500, 20_000, 100_000, 190_080)]
+    assert budgets == [11_000, 15_000, 35_000, 58_000]
+    assert criterion.budget(10**7) == 60_000 and all(b % 1000 == 0 for b in budgets)
+
+
+def test_plateau_needs_a_window_without_relative_improvement():
+    criterion = convergence.Criterion(window=3, min_improvement=0.01)
+    assert not criterion.plateaued([50.0, 49.0, 48.0])  # no evaluation before the window yet
+    assert not criterion.plateaued([50.0, 40.0, 35.0, 34.0, 33.0])  # still improving by > 1 %
+    assert criterion.plateaued([50.0, 40.0, 39.9, 40.5, 39.7])  # best 39.7 vs 40.0 before: 0.75 % < 1 %
+    assert not criterion.plateaued([50.0, 40.0, 39.9, 40.5, 39.5])  # 1.25 % better: still improving
+    assert criterion.plateaued([30.0, 31.0, 32.0, 33.0])  # worse over the window
+    assert criterion.decay_steps(40_000) == 4_000 and criterion.decay_steps(3_000) == 1_000
+
+
+@pytest.mark.parametrize("improvement, budget, converged", [(0.9, 40, True), (0.0, 10, False)])
+def test_train_until_converged(smoke, improvement, budget, converged):
+    examples, validation = smoke["train"], smoke["validation"]
+    spec = ModelSpec("size=64/seed=0", np.arange(64), seed=0)
+    criterion = convergence.Criterion(eval_every=5, window=2, min_improvement=improvement, base_steps=budget,
+                                      steps_per_example=0.0, max_steps=budget, min_decay_steps=3)
+    lines = []
+    model = convergence.train_until_converged(TINY_SMOKE, examples, spec, validation, criterion, log=lines.append)
+    # Needing a 90 % improvement, the criterion ends the phase at its first chance (3 scores); the 10-step budget
+    # ends it before the criterion can (2 scores).
+    assert model.converged is converged
+    assert model.constant_steps == (15 if converged else 10) and model.decay_steps == 3 and model.steps == \
+        int(model.state.step)
+    assert [step for step, *_ in model.validation] == ([5, 10, 15, 18] if converged else [5, 10, 13])
+    assert len(lines) == len(model.validation) and np.isfinite(model.validation).all()
+    learning_rate = float(model.state.opt_state.hyperparams["learning_rate"])
+    assert learning_rate == pytest.approx(TINY_SMOKE.learning_rate * criterion.final_lr_fraction, rel=1e-5)
+    assert model.validation[-1][1:] == pytest.approx(
+        convergence.validation_errors(model.model, model.state, validation, 64))
