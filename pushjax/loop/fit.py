@@ -41,13 +41,16 @@ class FitSettings:
     """Optimiser settings.
 
     Attributes:
-      steps: Adam steps (full batch).
+      steps: Adam steps (full batch) of a fit from "no effect".
+      warm_steps: Adam steps of a fit that starts from fitted parameters (a later round of selection, a refit, a group
+        of the mechanism check): the parameters it starts from are already near the optimum.
       learning_rate: initial step size in units of each parameter's typical magnitude (cosine decay).
       translation_floor_mm: smoothing of the translation error near 0, mm.
       rotation_floor_deg: smoothing of the rotation error near 0, deg.
     """
 
     steps: int = 300
+    warm_steps: int = 100
     learning_rate: float = 0.05
     translation_floor_mm: float = 0.1
     rotation_floor_deg: float = 0.1
@@ -196,10 +199,10 @@ def _masks(candidates: Sequence[Sequence[str]], exact: bool) -> np.ndarray:
     return np.array([[name in candidate for name in _family_names(exact)] for candidate in candidates], np.float32)
 
 
-def _slots(count: int) -> int:
-    """Candidates are padded to a power of two: few compiled programs over the rounds of selection, and no exact
-    limit surface solved for many padding slots when one candidate needs it."""
-    return 1 << max(count - 1, 0).bit_length()
+def _slots(count: int, family_size: int) -> int:
+    """Candidates are padded to a power of two up to the family's size: few compiled programs over the rounds of
+    selection, and no exact limit surface solved for many padding slots when one candidate needs it."""
+    return max(count, min(family_size, 1 << max(count - 1, 0).bit_length()))
 
 
 def _stack(trees):
@@ -219,7 +222,8 @@ def fit_effects(
       examples: the fit windows.
       settings: optimiser settings.
       initial: per candidate, None or SI parameters {effect: {parameter: value}} to start from
-        (effects not given start at "no effect").
+        (effects not given start at "no effect"); a family whose every candidate starts from given parameters is
+        fitted with ``settings.warm_steps``.
 
     Returns:
       One :class:`FitResult` per candidate, in order.
@@ -239,7 +243,7 @@ def fit_effects(
         if not members:
             continue
         names = _family_names(exact)
-        slots = _slots(len(members))
+        slots = _slots(len(members), len(names))
         group = [candidates[k] for k in members]
         masks = _masks(group + [()] * (slots - len(group)), exact)
         starts = []
@@ -249,9 +253,10 @@ def fit_effects(
                 if name in params:
                     params[name] = {key: jnp.asarray(value, jnp.float32) for key, value in values.items()}
             starts.append(_scaled_from_params(params))
+        warm = all(initial[k] for k in members)
         scaled, losses = _optimise(_stack(starts), jnp.asarray(masks), batch.inputs, batch.target, batch.weight,
-                                   scales, floors, steps=settings.steps, learning_rate=settings.learning_rate,
-                                   exact=exact)
+                                   scales, floors, steps=settings.warm_steps if warm else settings.steps,
+                                   learning_rate=settings.learning_rate, exact=exact)
         for slot, k in enumerate(members):
             one = jax.tree.map(lambda leaf: leaf[slot], scaled)
             params = jax.device_get(_params_from_scaled(one, jnp.asarray(masks[slot]), exact))
@@ -321,7 +326,7 @@ def predict(results: Sequence[FitResult | None], examples: Examples) -> np.ndarr
         if not members:
             continue
         names = _family_names(exact)
-        slots = _slots(len(members))
+        slots = _slots(len(members), len(names))
         params = []
         for k in members + [None] * (slots - len(members)):
             full = effects_lib.init_params(names)

@@ -17,7 +17,7 @@ def test_writes_the_report(record, tmp_path):
     result = run(f"--data_dir={record('pressure')}", f"--workdir={tmp_path}", "--seed=3")
     assert result.returncode == 0, result.stderr
     report = json.loads((tmp_path / "report.json").read_text())
-    assert report["selected"][:1] == ["friction_ratio"]
+    assert report["selected"][:1] == ["limit_surface"]  # the centre-loaded pressure: the exact surface's rim mode
     assert json.loads(result.stdout[:result.stdout.rindex("}") + 1])["selected"] == report["selected"]
     assert (tmp_path / "report.md").is_file() and (tmp_path / "details.json").is_file()
 
