@@ -1,7 +1,7 @@
 r"""Close the loop on measured pushes: residual → the missing effect → refit → test-split error before and after.
 
   python -m experiments.close_loop --data_dir=DIR --workdir=OUT [--horizon=0.5] [--seed=0] \
-      [--heldout_fraction=0.25] [--min_gain=0.05] [--min_strength=0.1] [--steps=300]
+      [--heldout_fraction=0.25] [--min_gain=0.05] [--min_strength=0.1] [--steps=300] [--effects=a,b,...]
 
 DIR holds pushes in the raw MIT layout (``<surface>/<object>/motion_surface=...h5``: real MIT files or the
 testbed's, ``python -m experiments.record_pushes``); only the streams and the file-name fields are used.
@@ -20,6 +20,7 @@ from absl import app, flags
 import experiments
 from pushjax.loop import LoopSettings, close_loop
 from pushjax.loop.fit import FitSettings
+from pushjax.physics.effects import EFFECT_NAMES
 
 _DATA_DIR = flags.DEFINE_string("data_dir", None, "Root of the pushes (raw MIT layout).", required=True)
 _WORKDIR = flags.DEFINE_string("workdir", None, "Output directory.", required=True)
@@ -33,6 +34,7 @@ _MIN_GAIN = flags.DEFINE_float("min_gain", LoopSettings.min_gain,
 _MIN_STRENGTH = flags.DEFINE_float("min_strength", LoopSettings.min_strength,
                                    "Share of the error a variable's correction must remove to count as structure.")
 _STEPS = flags.DEFINE_integer("steps", FitSettings.steps, "Adam steps per effect fit.", lower_bound=1)
+_EFFECTS = flags.DEFINE_list("effects", list(EFFECT_NAMES), "Candidate library effects (default: all).")
 experiments.require_writable_folder("workdir")
 
 
@@ -49,8 +51,12 @@ def main(argv):
                              f"{_MIN_GAIN.value}")
     if not 0 <= _MIN_STRENGTH.value <= 1:
         raise app.UsageError(f"--min_strength: expected a share of the error in [0, 1], got {_MIN_STRENGTH.value}")
+    unknown = sorted(set(_EFFECTS.value) - set(EFFECT_NAMES))
+    if unknown or not _EFFECTS.value:
+        raise app.UsageError(f"--effects: expected library effects from {','.join(EFFECT_NAMES)}, got "
+                             f"{','.join(_EFFECTS.value) or 'none'}")
     settings = LoopSettings(horizon=_HORIZON.value, test_fraction=_HELDOUT.value, min_gain=_MIN_GAIN.value,
-                            min_strength=_MIN_STRENGTH.value,
+                            min_strength=_MIN_STRENGTH.value, effects=tuple(_EFFECTS.value),
                             fit=dataclasses.replace(FitSettings(), steps=_STEPS.value))
     try:
         report = close_loop(_DATA_DIR.value, _WORKDIR.value, settings, seed=_SEED.value)

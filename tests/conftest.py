@@ -12,6 +12,18 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 SHARED = pathlib.Path(__file__).resolve().parents[1].parent / "shared"
 
 
+def pytest_configure(config):
+    """One persistent XLA compilation cache for every pytest-xdist worker (in pytest's cache folder), set before
+    anything compiles: the loop's data sets compile the same fitting programs, the exact limit surface's in 10-20 s
+    each, and without the cache every data set compiles them again."""
+    if getattr(config, "cache", None) is None:
+        return
+    import jax
+
+    jax.config.update("jax_compilation_cache_dir", str(config.cache.mkdir("xla_compilation_cache")))
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
+
+
 @pytest.fixture(scope="session")
 def shared_dir() -> pathlib.Path:
     """The reference data folder beside the repository; tests that need it skip without it."""

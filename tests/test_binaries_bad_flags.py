@@ -189,6 +189,8 @@ CASES = [
                            ("heldout_fraction", ("0", "1.5", "nan")), ("min_gain", ("-0.1", "1", "nan")),
                            ("min_strength", ("-0.1", "2", "nan")), ("steps", ("0",)))
       for value in values],
+    ("close_loop", ["--data_dir={empty}", "--workdir={tmp}/loop", "--effects=limit_surface,grain"], "--effects"),
+    ("close_loop", ["--data_dir={empty}", "--workdir={tmp}/loop", "--effects="], "--effects"),
     ("close_loop", ["--data_dir={empty}", "--workdir={tmp}/loop", "extra"], "unexpected arguments"),
     # findings
     ("findings", [], "--workdirs"),

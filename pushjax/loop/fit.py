@@ -32,7 +32,7 @@ from pushjax.loop.windows import Examples
 from pushjax.physics import effects as effects_lib
 from pushjax.physics.effects import EFFECT_NAMES, EFFECTS, ELLIPSOID_EFFECTS, PushInputs
 
-PAD_MULTIPLE = 1024
+PAD_MULTIPLE = 256
 """Example counts are padded (with zero weight) to a multiple of this, so programs compile once per size."""
 
 
@@ -189,10 +189,16 @@ def _physical_jacobian(scaled, mask, exact):
     flat, unravel = ravel_pytree(scaled)
 
     def values(flat):
-        params = _params_from_scaled(unravel(flat), mask, exact)
-        return ravel_pytree(effects_lib.physical_params(params))[0]
+        return effects_lib.physical_params(_params_from_scaled(unravel(flat), mask, exact))
 
-    return values(flat), jax.jacfwd(values)(flat)
+    return values(flat), jax.jacfwd(lambda flat: ravel_pytree(values(flat))[0])(flat)
+
+
+def _unflatten_like(tree, flat: np.ndarray):
+    """``flat`` (the leaves of ``tree`` raveled in order, as :func:`ravel_pytree` does) in the structure of ``tree``."""
+    leaves, treedef = jax.tree.flatten(tree)
+    parts = np.split(flat, np.cumsum([np.size(leaf) for leaf in leaves])[:-1])
+    return jax.tree.unflatten(treedef, [part.reshape(np.shape(leaf)) for part, leaf in zip(parts, leaves)])
 
 
 def _masks(candidates: Sequence[Sequence[str]], exact: bool) -> np.ndarray:
@@ -257,9 +263,10 @@ def fit_effects(
         scaled, losses = _optimise(_stack(starts), jnp.asarray(masks), batch.inputs, batch.target, batch.weight,
                                    scales, floors, steps=settings.warm_steps if warm else settings.steps,
                                    learning_rate=settings.learning_rate, exact=exact)
+        scaled, losses = jax.device_get((scaled, losses))
         for slot, k in enumerate(members):
             one = jax.tree.map(lambda leaf: leaf[slot], scaled)
-            params = jax.device_get(_params_from_scaled(one, jnp.asarray(masks[slot]), exact))
+            params = _params_from_scaled(one, masks[slot], exact)
             results[k] = FitResult(
                 effects=candidates[k],
                 params={name: {key: np.asarray(value) for key, value in params[name].items()}
@@ -299,12 +306,10 @@ def _physical_with_std(scaled, mask, batch, scales, floors, sequence, candidate,
     inverse = eigenvectors @ np.diag(1.0 / np.maximum(np.abs(eigenvalues), floor)) @ eigenvectors.T
     meat = per_sequence.T @ per_sequence * len(ids) / max(len(ids) - 1, 1)
     covariance = inverse @ meat @ inverse
-    values, value_jacobian = jax.device_get(_physical_jacobian(scaled, jnp.asarray(mask), exact))
+    value_tree, value_jacobian = jax.device_get(_physical_jacobian(scaled, jnp.asarray(mask), exact))
     value_jacobian = np.asarray(value_jacobian, np.float64)[:, active]
     std = np.sqrt(np.maximum(np.einsum("qp,pr,qr->q", value_jacobian, covariance, value_jacobian), 0.0))
-    physical = effects_lib.physical_params(jax.device_get(_params_from_scaled(scaled, jnp.asarray(mask), exact)))
-    _, unravel = ravel_pytree(jax.tree.map(np.asarray, physical))
-    value_tree, std_tree = unravel(np.asarray(values)), unravel(std)
+    std_tree = _unflatten_like(value_tree, std)
     # A value whose derivative does not exist at the optimum (e.g. an axis at zero anisotropy) has no std.
     return {name: {key: {"value": float(value_tree[name][key]),
                          "std": float(std_tree[name][key]) if np.isfinite(std_tree[name][key]) else None}

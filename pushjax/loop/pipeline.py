@@ -18,6 +18,7 @@ import tqdm
 from pushjax import planar
 from pushjax.loop import correction as correction_lib
 from pushjax.loop import diagnose as diagnose_lib
+from pushjax.loop import force as force_lib
 from pushjax.loop import fit as fit_lib
 from pushjax.loop import metrics
 from pushjax.loop import report as report_lib
@@ -37,7 +38,10 @@ class LoopSettings:
       stride: time between window starts, s (default ``horizon / 2``).
       test_fraction: share of push sequences in the untouched test split.
       select_fraction: share of push sequences in the select split (when not cross-fitted).
-      pusher_friction: nominal pusher-object friction coefficient.
+      pusher_friction: nominal pusher-object friction coefficient, used where the force sensor does not measure it.
+      measure_pusher_friction: give the model the pusher-object friction that the force sensor measured on the pool's
+        sliding pushes (:mod:`pushjax.loop.force`) and drop ``pusher_friction`` from the candidates, where enough
+        sequences slid.
       effects: candidate library effects.
       min_gain: share of the current selection error above the noise floor that an effect must remove to be
         selected (on top of being beyond noise).
@@ -53,6 +57,7 @@ class LoopSettings:
     test_fraction: float = splits_lib.TEST_FRACTION
     select_fraction: float = splits_lib.SELECT_FRACTION
     pusher_friction: float = NOMINAL_PUSHER_FRICTION
+    measure_pusher_friction: bool = True
     effects: tuple[str, ...] = EFFECT_NAMES
     min_gain: float = select_lib.MIN_GAIN
     min_strength: float = diagnose_lib.MIN_STRENGTH
@@ -67,7 +72,8 @@ class Decision:
     """What the fit and select sequences decided (see :func:`decide`).
 
     Attributes:
-      split: the roles of the sequences.
+      split: the roles of the sequences (with the measured pusher friction in their inputs where it is used).
+      force: the pusher–object friction that the force sensor read on the pool's sliding pushes.
       selection: ranking, rounds and the selected model.
       fallback_gain: relative selection-error cut of the learned error term over the selected model.
       fallback_p_value: its one-sided sign-flip p-value.
@@ -79,6 +85,7 @@ class Decision:
     """
 
     split: splits_lib.Split
+    force: force_lib.ForceFriction
     selection: select_lib.Selection
     fallback_gain: float
     fallback_p_value: float
@@ -115,12 +122,18 @@ def decide(examples: Examples, settings: LoopSettings = LoopSettings(), seed: in
     report = progress or (lambda message: None)
     split = splits_lib.split(examples, len(settings.effects), settings.alpha, settings.test_fraction,
                              settings.select_fraction, seed)
+    force = force_lib.estimate(split.pool.push_friction, split.pool.push, split.pool.sequence)
+    effects = settings.effects
+    if settings.measure_pusher_friction and force.measured:
+        split = dataclasses.replace(split, pool=with_pusher_friction(split.pool, force.value),
+                                    test=with_pusher_friction(split.test, force.value))
+        effects = tuple(name for name in effects if name != "pusher_friction")
     diagnose = dict(min_strength=settings.min_strength, n_bootstrap=settings.n_bootstrap, alpha=settings.alpha,
                     seed=seed)
     variables = [name for name, values in split.pool.variables.items() if len(np.unique(values)) > 1]
     report("diagnosing the plain model")
     before = diagnose_lib.diagnose(split.pool, fit_lib.predict([None], split.pool)[0], variables, **diagnose)
-    selection = select_lib.select_effects(split, settings.effects, settings.fit, settings.min_gain, settings.alpha,
+    selection = select_lib.select_effects(split, effects, settings.fit, settings.min_gain, settings.alpha,
                                           seed, report)
     final = selection.final
     report("fitting the learned error term on each fold")
@@ -137,10 +150,15 @@ def decide(examples: Examples, settings: LoopSettings = LoopSettings(), seed: in
     after = diagnose_lib.diagnose(selection_windows, final.prediction, variables, **diagnose)
     residual = selection_windows.target - final.prediction
     local = np.column_stack([planar.rotate(residual[:, :2], -selection_windows.inputs.object_yaw), residual[:, 2]])
-    return Decision(split=split, selection=selection, fallback_gain=float(gains.sum() / final.score),
+    return Decision(split=split, force=force, selection=selection, fallback_gain=float(gains.sum() / final.score),
                     fallback_p_value=float(metrics.sign_flip_pvalues(gains, seed=seed)[0]), variables=variables,
                     diagnosis_before=before, diagnosis_after=after, noise=np.sqrt(np.mean(local ** 2, axis=0)),
                     alpha=settings.alpha)
+
+
+def with_pusher_friction(examples: Examples, mu: float) -> Examples:
+    """``examples`` with the pusher–object friction coefficient ``mu`` in every window's model inputs."""
+    return dataclasses.replace(examples, inputs=examples.inputs.replace(mu=np.full(len(examples), float(mu))))
 
 
 def _dependences(dependences: list[diagnose_lib.Dependence]) -> list[dict]:
@@ -233,6 +251,9 @@ def close_loop(
             "selected": selection.selected,
             "after": after,
             "noise_floor": floor.as_dict(),
+            "pusher_friction": {"nominal": settings.pusher_friction, "force_sensor": decision.force.as_dict(),
+                                "from_force_sensor": settings.measure_pusher_friction and decision.force.measured,
+                                "used": float(pool.inputs.mu[0])},
             "explained": explained,
             "fallback": measured(fallback_mean),
             "remaining": {"above_floor": above,

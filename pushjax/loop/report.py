@@ -146,6 +146,17 @@ def markdown(report: dict, details: dict) -> str:
     lines += [f"| {entry['effect']} | {_params_text(entry['params'])} | "
               f"{entry['select']['trans_pct'] + entry['select']['rot_pct']:.1f} | {entry['select']['trans_mm']:.3f} | "
               f"{entry['select']['rot_deg']:.3f} |" for entry in report["ranking"]]
+    friction, sensor = report["pusher_friction"], report["pusher_friction"]["force_sensor"]
+    lines += ["", "## Pusher friction from the force sensor", "",
+              (f"While the pusher slid along the object, the force sensor read a pusher–object friction coefficient of "
+               f"{sensor['value']:.3f} ± {sensor['std'] or 0:.3f} ({sensor['n_sequences']} pool sequences, "
+               f"{sensor['n_pushes_without']} pushes without sliding or force; nominal {friction['nominal']:g})"
+               if sensor["value"] is not None else
+               f"No pool push slid with a force reading ({sensor['n_pushes_without']} pushes)") + ". "
+              + (f"Every model uses the measured {friction['used']:.3f}, and `pusher_friction` is not a candidate: "
+                 "a measured parameter is no knob." if friction["from_force_sensor"] else
+                 f"The models use the nominal {friction['used']:g}"
+                 + (" (too few sequences slid for a measurement)." if not sensor["measured"] else "."))]
     select_floor = details["select_noise_floor"]
     lines += ["", "## Forward selection", "",
               f"Every candidate of a round is tested: its gain on the select split must be beyond noise (one-sided "

@@ -26,6 +26,7 @@ import numpy as np
 
 from pushjax import planar
 from pushjax.geometry import OBJECT_NAMES, PUSHER_RADIUS, annotate, get_object, limit_surface_ratio, support_cells
+from pushjax.loop.force import sliding_friction
 from pushjax.mit.files import Push
 from pushjax.physics.effects import PushInputs
 
@@ -68,6 +69,8 @@ class Examples:
         time after the pusher's first motion).
       tracking_noise: [N, 3] standard deviation of the pose measurement of the window's push (x m, y m, yaw rad),
         estimated from the pose stream (:func:`tracking_noise`).
+      push_friction: [N] the pusher–object friction coefficient that the force sensor read while the window's push
+        slid (:func:`pushjax.loop.force.sliding_friction`; NaN where it never slid or read no force).
       variables: {name: [N] values} of the candidate explanatory variables (see :data:`VARIABLES`).
       sequence_names: names of the sequences, indexed by ``sequence``.
     """
@@ -78,6 +81,7 @@ class Examples:
     push: np.ndarray
     window: np.ndarray
     tracking_noise: np.ndarray
+    push_friction: np.ndarray
     variables: dict[str, np.ndarray]
     sequence_names: tuple[str, ...]
 
@@ -97,8 +101,8 @@ class Examples:
         return Examples(
             inputs=jax.tree.map(lambda values: np.asarray(values)[mask], self.inputs),
             target=self.target[mask], sequence=self.sequence[mask], push=self.push[mask], window=self.window[mask],
-            tracking_noise=self.tracking_noise[mask], variables={name: values[mask] for name, values in self.variables.items()},
-            sequence_names=self.sequence_names,
+            tracking_noise=self.tracking_noise[mask], push_friction=self.push_friction[mask],
+            variables={name: values[mask] for name, values in self.variables.items()}, sequence_names=self.sequence_names,
         )
 
 
@@ -213,6 +217,7 @@ def build_examples(
         n_pushes += 1
         sequence = sequence_index.setdefault(_sequence_key(push), len(sequence_index))
         stop_time = push.time[stop]
+        noise = tracking_noise(push.object)
         speed_until = np.minimum(ends, stop)
         rows[push.params.shape].append(dict(
             pose0=push.object[starts], pose1=push.object[ends], tip0=push.tip[starts, :2],
@@ -223,7 +228,8 @@ def build_examples(
             sequence=np.full(len(starts), sequence),
             push=np.full(len(starts), n_pushes - 1),
             window=np.arange(len(starts)),
-            tracking_noise=np.broadcast_to(tracking_noise(push.object), (len(starts), 3)),
+            tracking_noise=np.broadcast_to(noise, (len(starts), 3)),
+            push_friction=np.full(len(starts), sliding_friction(push, get_object(push.params.shape), noise)),
             params=push.params,
         ))
     if n_pushes == 0:
@@ -241,7 +247,8 @@ def build_examples(
     variables = {name: np.concatenate([part["variables"][name] for part in parts]) for name in VARIABLES}
     inputs = PushInputs(**{field.name: merged[field.name] for field in dataclasses.fields(PushInputs)})
     examples = Examples(inputs=inputs, target=merged["target"], sequence=merged["sequence"], push=merged["push"],
-                        window=merged["window"], tracking_noise=merged["tracking_noise"], variables=variables,
+                        window=merged["window"], tracking_noise=merged["tracking_noise"],
+                        push_friction=merged["push_friction"], variables=variables,
                         sequence_names=tuple(sequence_index))
     return examples, BuildSummary(n_pushes=n_pushes, skipped=dict(skipped))
 
@@ -296,6 +303,7 @@ def _annotate_object(name: str, rows: list[dict], pusher_friction: float) -> dic
         patch_radius=np.full(count, patch_radius),
         target=np.column_stack([com1 - com0, pose1[:, 2] - pose0[:, 2]]),
         sequence=data["sequence"], push=data["push"], window=data["window"], tracking_noise=data["tracking_noise"],
+        push_friction=data["push_friction"],
         variables=variables,
     )
 

@@ -15,11 +15,13 @@ import pytest
 from pushjax.loop.metrics import combined
 from pushjax.physics.effects import EFFECT_NAMES
 from pushjax.sim.effects import Effects
+from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
 
 from .conftest import CASES, KNOWN_FALSE_DISCOVERIES, REAL_DIFFERENCES
 
 SUMMARY_KEYS = {"trans_pct", "rot_pct", "trans_mm", "rot_deg"}
 SINGLE = [name for name, case in CASES.items() if case.effects != Effects() and case.expected and "_and_" not in name]
+MEASURED = [name for name, case in CASES.items() if case.pusher_friction != PUSHER_OBJECT_FRICTION]
 
 
 @pytest.mark.parametrize("name", SINGLE)
@@ -31,11 +33,25 @@ def test_injected_effect_is_selected_with_no_false_discovery_and_cuts_the_test_e
     assert combined(report["after"]) <= 0.7 * combined(report["baseline"])
 
 
+@pytest.mark.parametrize("name", MEASURED)
+def test_pusher_friction_is_measured_by_the_force_sensor_not_fitted(name, loop_report):
+    report, workdir = loop_report(name)
+    friction = report["pusher_friction"]
+    assert friction["from_force_sensor"] and friction["force_sensor"]["measured"]
+    assert friction["used"] == friction["force_sensor"]["value"] == pytest.approx(CASES[name].pusher_friction, rel=0.02)
+    assert "pusher_friction" not in report["selected"]
+    assert "pusher_friction" not in {entry["effect"] for entry in report["ranking"]}
+    assert "Pusher friction from the force sensor" in (workdir / "report.md").read_text()
+
+
 def test_report_follows_the_schema(loop_report):
     report, workdir = loop_report("com_offset")
     assert json.loads((workdir / "report.json").read_text()) == report
     assert set(report) == {"n_pushes", "baseline", "diagnosis", "ranking", "selected", "after", "noise_floor",
-                           "explained", "fallback", "remaining", "uncertainty"}
+                           "pusher_friction", "explained", "fallback", "remaining", "uncertainty"}
+    friction = report["pusher_friction"]
+    assert set(friction) == {"nominal", "force_sensor", "from_force_sensor", "used"}
+    assert set(friction["force_sensor"]) == {"value", "std", "n_sequences", "n_pushes", "n_pushes_without", "measured"}
     floor = report["noise_floor"]
     assert floor["source"] == "tracking" and floor["n_windows"] > 0  # no push is repeated
     assert set(report["remaining"]) == {"above_floor", "variables"}
@@ -52,7 +68,7 @@ def test_report_follows_the_schema(loop_report):
     strengths = [entry["strength"] for entry in report["diagnosis"]]
     assert strengths == sorted(strengths, reverse=True)
     assert all(set(entry) == {"variable", "strength"} for entry in report["diagnosis"])
-    assert sorted(entry["effect"] for entry in report["ranking"]) == sorted(EFFECT_NAMES)
+    assert sorted(entry["effect"] for entry in report["ranking"]) == sorted(set(EFFECT_NAMES) - {"pusher_friction"})
     for entry in report["ranking"]:
         assert set(entry) == {"effect", "params", "select"} and set(entry["select"]) == SUMMARY_KEYS
         assert all(set(value) == {"value", "std"} for value in entry["params"].values())

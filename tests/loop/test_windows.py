@@ -79,6 +79,7 @@ def test_effect_attributes_are_never_read(tmp_path):
     undeclared, _ = build_examples(iter_pushes(tmp_path / "undeclared"))
     for field in dataclasses.fields(PushInputs):
         np.testing.assert_array_equal(getattr(declared.inputs, field.name), getattr(undeclared.inputs, field.name))
+    np.testing.assert_array_equal(declared.push_friction, undeclared.push_friction)
     np.testing.assert_array_equal(declared.target, undeclared.target)
     # The triangle's centroid is not its tracked frame: the target is the centroid's displacement.
     centroid = get_object("tri1").centroid

@@ -1,0 +1,135 @@
+"""The pusher–object friction read from the force sensor, so that the motion fit cannot use it as a knob.
+
+While the pusher slides along the object, Coulomb friction holds the contact force on the edge of the friction cone:
+``|F_t| / F_n = mu`` (Lynch's model and the exact limit surface assume the same). Sliding is read from the kinematics
+alone — the touched point, averaged over :data:`SLIDE_LAG`, moves along the object's outline by more than
+:data:`MIN_SLIDE` and four standard deviations of its tracking noise within :data:`SLIDE_LAG` — and the force from ``ft_wrench`` (the force the pusher applies to the object, world axes), so the estimate uses no
+model of the object's motion. A push's estimate is the :data:`SLIDING_QUANTILE` percentile of the ratio over its sliding
+samples (samples that tracking noise makes look sliding while the contact sticks lie inside the cone, below ``mu``);
+pushes that never slide
+(their force stays inside the cone) or whose force sensor reads nothing have none and are counted.
+
+With this measurement the motion fit has no reason left to move the pusher friction: the loop gives the model the
+measured coefficient and drops ``pusher_friction`` from the candidates (:func:`pushjax.loop.pipeline.decide`). On clean
+testbed pushes the sensor reads the simulated 0.250 while the motion fit of ``pusher_friction`` on top of the exact
+limit surface asks for 0.28: that scale was a knob absorbing another misfit, not the pusher's friction.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from pushjax import planar
+from pushjax.geometry import PUSHER_RADIUS, PushObject, annotate
+from pushjax.mit.files import Push
+
+SLIDE_LAG = 0.1
+"""Time over which the touched point's motion along the outline is measured, s."""
+MIN_SLIDE = 5e-4
+"""Motion of the touched point along the outline within :data:`SLIDE_LAG` (m) above which the pusher slides."""
+MIN_NORMAL_FORCE_SHARE = 0.1
+"""Samples whose normal force is below this share of the push's largest carry too little force for a ratio."""
+SLIDING_QUANTILE = 90
+"""Percentile of a push's sliding samples' force ratios taken as its coefficient."""
+MIN_SLIDING_SAMPLES = 5
+"""A push needs this many sliding samples for an estimate."""
+MIN_SEQUENCES = 8
+"""Push sequences with an estimate needed before the measurement replaces the nominal coefficient."""
+
+
+def sliding_friction(push: Push, obj: PushObject, noise: np.ndarray) -> float:
+    """The pusher–object friction coefficient of one push from its sliding samples, NaN when it has too few.
+
+    Args:
+      push: a cleaned push (object and tip poses m, rad; wrench [T, 3] fx N, fy N, torque N·m, world axes).
+      obj: the pushed object.
+      noise: [3] standard deviation of the object pose's tracking noise (x m, y m, yaw rad).
+    """
+    dt = float(np.median(np.diff(push.time))) if len(push.time) > 1 else math.inf
+    lag = max(1, round(SLIDE_LAG / dt)) if math.isfinite(dt) else 0
+    if lag == 0 or len(push.time) <= lag:
+        return math.nan
+    tip, pose = push.tip[:, :2], push.object
+    # Annotated along the pusher's motion over the next lag (at rest: towards the object's centre).
+    motion = np.concatenate([tip[lag:] - tip[:-lag], np.zeros((lag, 2))])
+    towards = pose[:, :2] - tip
+    direction = np.where(np.linalg.norm(motion, axis=1, keepdims=True) > 1e-6, motion, towards)
+    contact = annotate(obj, pose, tip, direction * (0.01 / np.maximum(np.linalg.norm(direction, axis=1),
+                                                                      1e-12))[:, None], radius=PUSHER_RADIUS)
+    touching = np.asarray(contact.touches) & (np.asarray(contact.first_contact_fraction) < 0.05)
+    normal = np.asarray(contact.normal)
+    local = _moving_average(planar.rotate(np.asarray(contact.contact_rel_com), -pose[:, 2]), lag)
+    # Tracking noise of the touched point (object position, and yaw times the lever arm; the tip's adds alike),
+    # averaged over the lag, on a difference of two averages.
+    lever = float(np.median(np.linalg.norm(np.asarray(contact.contact_rel_com)[touching], axis=1))) \
+        if np.any(touching) else 0.0
+    point_noise = math.sqrt(2.0) * math.hypot(float(np.hypot(noise[0], noise[1])), float(noise[2]) * lever)
+    threshold = max(MIN_SLIDE, 4.0 * point_noise * math.sqrt(2.0 / lag))
+    slide = np.zeros(len(tip), bool)
+    same_side = np.sum(normal[lag:] * normal[:-lag], axis=1) > 0.99
+    slide[:-lag] = (touching[:-lag] & touching[lag:] & same_side
+                    & (np.linalg.norm(local[lag:] - local[:-lag], axis=1) > threshold))
+    force = push.wrench[:, :2]
+    normal_force = np.sum(force * normal, axis=1)
+    tangential_force = np.abs(force[:, 0] * normal[:, 1] - force[:, 1] * normal[:, 0])
+    loaded = normal_force > MIN_NORMAL_FORCE_SHARE * max(float(np.max(normal_force, initial=0.0)), 1e-9)
+    used = slide & loaded
+    if np.count_nonzero(used) < MIN_SLIDING_SAMPLES:
+        return math.nan
+    return float(np.percentile(tangential_force[used] / normal_force[used], SLIDING_QUANTILE))
+
+
+def _moving_average(values: np.ndarray, width: int) -> np.ndarray:
+    """[T, D] centred moving average over ``width`` samples (shorter at the ends)."""
+    kernel = np.ones(width)
+    counts = np.convolve(np.ones(len(values)), kernel, mode="same")
+    return np.column_stack([np.convolve(column, kernel, mode="same") for column in values.T]) / counts[:, None]
+
+
+@dataclasses.dataclass(frozen=True)
+class ForceFriction:
+    """The pusher–object friction of a set of windows' pushes.
+
+    Attributes:
+      value: mean over push sequences of their pushes' mean estimate (None without any).
+      std: its standard error over sequences (None with fewer than two).
+      n_sequences: sequences with an estimate.
+      n_pushes: pushes with an estimate.
+      n_pushes_without: pushes without one (they never slid, or their sensor read no force).
+    """
+
+    value: float | None
+    std: float | None
+    n_sequences: int
+    n_pushes: int
+    n_pushes_without: int
+
+    @property
+    def measured(self) -> bool:
+        """Whether enough sequences slid for the measurement to replace the nominal coefficient."""
+        return self.value is not None and self.n_sequences >= MIN_SEQUENCES
+
+    def as_dict(self) -> dict:
+        return {**dataclasses.asdict(self), "measured": self.measured}
+
+
+def estimate(push_friction: np.ndarray, push: np.ndarray, sequence: np.ndarray) -> ForceFriction:
+    """Pools per-push estimates by sequence.
+
+    Args:
+      push_friction: [N] the estimate of each window's push (NaN: none), e.g. ``Examples.push_friction``.
+      push: [N] push index of each window.
+      sequence: [N] sequence index of each window.
+    """
+    _, first = np.unique(push, return_index=True)
+    values, sequences = push_friction[first], sequence[first]
+    known = np.isfinite(values)
+    per_sequence = np.array([np.mean(values[known & (sequences == s)]) for s in np.unique(sequences[known])])
+    n = len(per_sequence)
+    return ForceFriction(
+        value=float(np.mean(per_sequence)) if n else None,
+        std=float(np.std(per_sequence, ddof=1) / math.sqrt(n)) if n > 1 else None,
+        n_sequences=n, n_pushes=int(np.count_nonzero(known)), n_pushes_without=int(np.count_nonzero(~known)))
