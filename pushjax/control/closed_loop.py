@@ -38,7 +38,7 @@ from pushjax.sim import push, scene
 from pushjax.sim.effects import Effects
 from pushjax.sim.testbed import Testbed, draw_conditions
 
-__all__ = ["EpisodeResult", "LoopConfig", "filter_periods", "run_episode", "waypoint_targets"]
+__all__ = ["EpisodeResult", "LoopConfig", "filter_period", "run_episode", "waypoint_targets"]
 
 PROCESS_STD_PER_S = (3.75e-4, 3.75e-4, 6.25e-3, 3e-2, 3e-2)
 """The filter's process noise per sqrt(s) (x m, y m, yaw rad, log mu, log l): ``experiments.track``'s values
@@ -106,16 +106,10 @@ class EpisodeResult:
 
 
 @jax.jit
-def filter_periods(system: models.System, mean, cov, pusher_path, measurements):
-    """(mean [5], cov [5, 5]) after predicting and updating through the periods of `pusher_path` [n + 1, 2] (world,
-    m) with `measurements` [n, 3] (x m, y m, yaw rad; NaN rows: dropped)."""
-
-    def body(belief, inputs):
-        pusher, increment, measurement = inputs
-        return models.update_linear(system, *ekf.predict(system, *belief, pusher, increment), measurement), None
-
-    (mean, cov), _ = jax.lax.scan(body, (mean, cov), (pusher_path[:-1], jnp.diff(pusher_path, axis=0), measurements))
-    return mean, cov
+def filter_period(system: models.System, mean, cov, pusher, increment, measurement):
+    """(mean [5], cov [5, 5]) after predicting through one control period, the pusher moving from `pusher` [2] by
+    `increment` [2] (world, m), and updating with `measurement` [3] (x m, y m, yaw rad; NaN: dropped)."""
+    return models.update_linear(system, *ekf.predict(system, mean, cov, pusher, increment), measurement)
 
 
 def waypoint_targets(start, waypoints, step: float, multiple: int) -> np.ndarray:
@@ -225,9 +219,9 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
             starts = commanded + np.concatenate([np.zeros((1, 2)), np.cumsum(steps, axis=0)[:-1]])
             targets = (starts[:, None] + fractions * steps[:, None]).reshape(-1, 2)
         tip_path, measurements = execute(targets)
-        path = np.concatenate([commanded[None], tip_path])
-        mean, cov = filter_periods(system, mean, cov, jnp.asarray(path, jnp.float32),
-                                   jnp.asarray(measurements, jnp.float32))
+        path = np.concatenate([commanded[None], tip_path]).astype(np.float32)
+        for begin, end, measurement in zip(path[:-1], path[1:], measurements.astype(np.float32)):
+            mean, cov = filter_period(system, mean, cov, begin, end - begin, measurement)
     execute(np.repeat(episode.pusher[None], max(1, round(loop.settle / config.period)) * samples_per_period, axis=0))
     poses, tips = np.concatenate(poses), np.concatenate(tips)
     final = poses[-1, 1:]
