@@ -118,7 +118,7 @@ def waypoint_targets(start, waypoints, step: float, multiple: int) -> np.ndarray
     points = np.concatenate([np.asarray(start, np.float64)[None], np.asarray(waypoints, np.float64)])
     targets = []
     for begin, end in zip(points[:-1], points[1:]):
-        pieces = max(1, math.ceil(np.linalg.norm(end - begin) / step * (1 + 1e-9)))
+        pieces = max(1, math.ceil(np.linalg.norm(end - begin) / step - 1e-9))
         targets.append(begin + np.arange(1, pieces + 1)[:, None] / pieces * (end - begin))
     targets = np.concatenate(targets)
     padding = -len(targets) % multiple
