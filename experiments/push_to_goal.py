@@ -9,6 +9,8 @@ Draws the goals (``pushjax.control.goals``), runs every model and planner on eac
 resumable from ``--workdir``/episodes.jsonl) and writes ``results.json``, ``results.md`` and ``trajectories.png``.
 """
 
+import math
+
 from absl import app, flags
 
 import experiments
@@ -33,6 +35,11 @@ _TESTBED_OVERRIDES = flags.DEFINE_string("testbed_overrides", "", "Testbed magni
 _EFFECTS = flags.DEFINE_string("effects", "", "Effects of the simulated world, e.g. 'table_tilt_deg=2'.")
 _MAX_TIME = flags.DEFINE_float("max_time", None, "Simulated seconds per goal (default: the scale's).", lower_bound=1)
 experiments.require_writable_folder("workdir")
+
+
+@flags.validator("max_time", "expected a finite number of seconds >= 1")
+def _check_max_time(value):
+    return value is None or math.isfinite(value)
 
 
 @flags.validator("objects", f"expected a non-empty list from {','.join(OBJECT_NAMES)}, no repeats")
