@@ -18,7 +18,6 @@ from pushjax.control import closed_loop, mpc, push_to_goal, report
 from pushjax.geometry.objects import OBJECT_NAMES
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
-from pushjax.sim.testbed import from_flags
 
 _WORKDIR = flags.DEFINE_string("workdir", None, "Folder for episodes.jsonl, results.json, results.md, the figure.",
                                required=True)
@@ -79,10 +78,7 @@ flags.register_validator("effects", _parsed_by(Effects.parse))
 def main(argv):
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
-    try:
-        testbed = from_flags(_TESTBED.value, _TESTBED_OVERRIDES.value)
-    except ValueError as error:
-        raise app.UsageError(f"--testbed_overrides: {error}") from None
+    testbed = experiments.testbed_from_flags(_TESTBED.value, _TESTBED_OVERRIDES.value)
     scale = push_to_goal.SCALES[_SCALE.value]
     loop = closed_loop.LoopConfig(max_time=_MAX_TIME.value or scale["max_time"], surface=_SURFACE.value,
                                   testbed=testbed, effects=Effects.parse(_EFFECTS.value))
