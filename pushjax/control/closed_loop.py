@@ -36,7 +36,7 @@ from pushjax.control.model import PushModel
 from pushjax.filter import ekf, models
 from pushjax.sim import push, scene
 from pushjax.sim.effects import Effects
-from pushjax.sim.testbed import Testbed, draw_conditions
+from pushjax.sim.testbed import REALISTIC, Testbed, draw_conditions
 
 __all__ = ["EpisodeResult", "LoopConfig", "filter_period", "run_episode", "waypoint_targets"]
 
@@ -58,7 +58,7 @@ class LoopConfig:
       patience: plans in a row without a helpful move that end pushing.
       settle: seconds the pusher stands still before the final pose is read.
       surface: surface name.
-      testbed: the testbed profile.
+      testbed: the testbed profile (realistic unless :data:`pushjax.sim.testbed.IDEAL` is asked for).
       effects: the simulated world's effects (:class:`pushjax.sim.effects.Effects`).
     """
 
@@ -68,7 +68,7 @@ class LoopConfig:
     patience: int = 5
     settle: float = 0.5
     surface: str = "abs"
-    testbed: Testbed = Testbed()
+    testbed: Testbed = REALISTIC
     effects: Effects = Effects()
 
 
@@ -187,8 +187,9 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
         return piece.tip_pose[ends, 1:3], _measured(piece, first_sample + 1 + ends)
 
     still = np.repeat(pusher[None], samples_per_period, axis=0)
-    _, first = execute(still)
-    observed = np.where(np.isfinite(first[-1]), first[-1], start)
+    observed = execute(still)[1][-1]
+    while not np.all(np.isfinite(observed)):  # the first measurement was dropped: wait for one
+        observed = execute(still)[1][-1]
     mean = jnp.asarray(np.concatenate([observed, [0.0, 0.0]]), jnp.float32)
     cov = jnp.diag(jnp.asarray(PRIOR_STD, jnp.float32) ** 2)
     estimates, plans, repositions, idle, stop = [], 0, 0, 0, "timeout"

@@ -100,6 +100,7 @@ class ControllerConfig:
 
     @property
     def planner_config(self):
+        """The chosen planner's settings."""
         return self.gradient if self.planner == "gradient" else self.sampling
 
 

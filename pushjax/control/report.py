@@ -95,7 +95,7 @@ def figure(results: dict, path: Path, count: int = 4) -> None:
     """A few episodes: the object's outline over time (light to dark), the goal (dashed), the pusher's path."""
     episodes = results["episodes"][:count]
     axes = plt.subplots(1, len(episodes), figsize=(3.4 * len(episodes), 3.4), squeeze=False)[1][0]
-    figure_ = axes[0].figure
+    drawing = axes[0].figure
     for axis, row in zip(axes, episodes):
         outline = get_object(row["object"]).outline
         poses = np.asarray(row["trajectory"]["poses"])
@@ -113,9 +113,9 @@ def figure(results: dict, path: Path, count: int = 4) -> None:
                        f"{row['position_error_mm']:.1f} mm, {row['yaw_error_deg']:.1f} deg", fontsize=8)
         axis.tick_params(labelsize=7)
     axes[0].legend(fontsize=7, loc="best")
-    figure_.tight_layout()
-    figure_.savefig(path, dpi=100)
-    plt.close(figure_)
+    drawing.tight_layout()
+    drawing.savefig(path, dpi=100)
+    plt.close(drawing)
 
 
 def write(results: dict, workdir: str | Path) -> list[Path]:

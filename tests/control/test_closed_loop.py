@@ -24,7 +24,8 @@ def test_waypoint_targets_keep_the_step_and_the_multiple():
 @pytest.fixture(scope="module")
 def episodes():
     push_model = model.make_model("rect1")
-    loop = closed_loop.LoopConfig(max_time=20.0, testbed=REALISTIC)
+    loop = closed_loop.LoopConfig(max_time=20.0)
+    assert loop.testbed == REALISTIC  # the default profile
     return [closed_loop.run_episode(push_model, CONFIG, "rect1", (0.0, 0.0, 0.0), (0.05, 0.02, 0.3), seed=1,
                                     loop=loop) for _ in range(2)]
 
