@@ -7,7 +7,8 @@ One :func:`run_episode` is one goal: the object rests at its start pose, the pus
 
 1. filters the motion capture of the periods since the last plan (the testbed's noise, jitter and drops in the
    realistic profile; a dropped sample is NaN and only predicted) with the extended Kalman filter of
-   :mod:`pushjax.filter.ekf`, whose process model is the same rollout step, one step per control period;
+   :mod:`pushjax.filter.ekf`, whose process model is the same rollout step, one step per control period (process
+   noise: :data:`pushjax.filter.tracking.PROCESS_STD_PER_S`, tuned there on testbed pushes);
 2. asks :func:`pushjax.control.mpc.replan` with the filtered pose and the commanded pusher position;
 3. has the testbed (:class:`pushjax.sim.push.Episode`: the testbed's scene, stepping and testbed draws) move the
    pusher through the plan's first steps, or along the detour of a reposition, at the 4 ms recording clock.
@@ -33,16 +34,13 @@ import numpy as np
 from pushjax.control import contact, mpc
 from pushjax.control.cost import wrap
 from pushjax.control.model import PushModel
-from pushjax.filter import ekf, models
+from pushjax.filter import ekf, models, tracking
 from pushjax.sim import push, scene
 from pushjax.sim.effects import Effects
 from pushjax.sim.testbed import REALISTIC, Testbed, draw_conditions
 
 __all__ = ["EpisodeResult", "LoopConfig", "filter_period", "run_episode", "waypoint_targets"]
 
-PROCESS_STD_PER_S = (3.75e-4, 3.75e-4, 6.25e-3, 3e-2, 3e-2)
-"""The filter's process noise per sqrt(s) (x m, y m, yaw rad, log mu, log l): ``experiments.track``'s values
-(:data:`pushjax.filter.tracking.PROCESS_STD_PER_S`, tuned there on testbed pushes)."""
 PRIOR_STD = (1e-3, 1e-3, 0.02, 0.3, 0.3)
 """Prior standard deviations of the filter at the first measurement (x m, y m, yaw rad, log mu, log l)."""
 
@@ -167,7 +165,7 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
                            rng=np.random.default_rng([*episode_key, 5]), conditions=conditions)
     measurement_std = (max(loop.testbed.tracking_noise_xy, 1e-5),) * 2 + (max(loop.testbed.tracking_noise_yaw, 1e-4),)
     system = models.make_system(obj, mu=float(model.mu), l=float(model.l),
-                                process_std=np.asarray(PROCESS_STD_PER_S) * math.sqrt(config.period),
+                                process_std=np.asarray(tracking.PROCESS_STD_PER_S) * math.sqrt(config.period),
                                 measurement_std=measurement_std, effects=model.effects, params=model.params)
     state = mpc.init(config, jax.random.fold_in(jax.random.key(seed), index))
     goal_array = jnp.asarray(goal, jnp.float32)
