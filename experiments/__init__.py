@@ -45,3 +45,12 @@ def define_testbed_flag() -> flags.FlagHolder:
     """Defines ``--testbed`` (``pushjax.sim.testbed.PROFILES``, default ``realistic``) for a binary that records or
     builds data without the experiments' shared flags (``pushjax.paper.cli`` defines it for those)."""
     return flags.DEFINE_enum("testbed", testbed.DEFAULT_PROFILE, list(testbed.PROFILES), testbed.FLAG_HELP)
+
+
+def testbed_from_flags(profile: str, overrides: str) -> testbed.Testbed:
+    """The testbed profile of ``--testbed`` with ``--testbed_overrides``; a bad override is a usage error naming
+    ``--testbed_overrides``."""
+    try:
+        return testbed.from_flags(profile, overrides)
+    except ValueError as error:
+        raise app.UsageError(f"--testbed_overrides: {error}") from None

@@ -15,7 +15,6 @@ from absl import app, flags
 
 import experiments
 from pushjax.filter import tracking
-from pushjax.sim.testbed import from_flags
 
 _WORKDIR = flags.DEFINE_string("workdir", None, "Folder for results.json, results.md and the figure.", required=True)
 _SCALE = flags.DEFINE_enum("scale", "cpu", list(tracking.SCALES), "Objects, pushes and particles (smoke: a test).")
@@ -47,10 +46,7 @@ def _check_rate(value):
 def main(argv):
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
-    try:
-        testbed = from_flags(_TESTBED.value, _TESTBED_OVERRIDES.value)
-    except ValueError as error:
-        raise app.UsageError(f"--testbed_overrides: {error}") from None
+    testbed = experiments.testbed_from_flags(_TESTBED.value, _TESTBED_OVERRIDES.value)
     scale = tracking.SCALES[_SCALE.value]
     rate = _RATE.value or scale["rate_hz"]
     pushes = tracking.simulate_pushes(scale["objects"], scale["pushes"], _SEED.value, testbed, rate)

@@ -23,6 +23,7 @@ SERVER = r"""
 import contextlib, json, os, runpy, signal, sys, time
 import experiments, pushjax.data, pushjax.loop, pushjax.paper.findings, pushjax.paper.figures, pushjax.paper.runner
 import pushjax.paper.spec, pushjax.paper.tables, pushjax.paper.visualize, pushjax.physics.demo, pushjax.sim.dataset
+import pushjax.control.push_to_goal
 
 
 def run_as_main(binary):
@@ -212,6 +213,20 @@ CASES = [
                            ("testbed", ("perfect",)), ("testbed_overrides", ("drop_rate=2", "wind=1")))
       for value in values],
     ("track", ["--workdir={tmp}/track", "extra"], "unexpected arguments"),
+    # push_to_goal
+    ("push_to_goal", [], "--workdir"),
+    ("push_to_goal", ["--workdir={file}/goals"], "--workdir"),
+    ("push_to_goal", ["--workdir={read_only}/goals"], "--workdir"),
+    *[("push_to_goal", ["--workdir={tmp}/goals", f"--{flag}={value}"], f"--{flag}")
+      for flag, values in (("scale", ("huge",)), ("objects", ("box", "rect1,rect1", "")),
+                           ("goals", ("0", "x")), ("models", ("newton", "lynch+wind", "")),
+                           ("effect_params", ("friction_ratio=1", "wind.speed=1")),
+                           ("planners", ("newton", "gradient,gradient", "")), ("seed", ("-1",)),
+                           ("surface", ("ice",)), ("testbed", ("perfect",)),
+                           ("testbed_overrides", ("drop_rate=2", "wind=1")), ("effects", ("gravity=2",)),
+                           ("max_time", ("0", "nan")))
+      for value in values],
+    ("push_to_goal", ["--workdir={tmp}/goals", "extra"], "unexpected arguments"),
     # demo
     *[("demo", [f"--{flag}={value}"], f"--{flag}")
       for flag, values in (("mu", ("-1", "nan", "inf")), ("angle_deg", ("90", "-120", "nan")),

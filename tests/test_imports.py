@@ -42,7 +42,7 @@ LAYERS = {
     "pushjax.physics": 2, "pushjax.mit": 2,
     "pushjax.sim": 3, "pushjax.render": 3, "pushjax.render.renderer": 3,
     "pushjax.data": 4, "pushjax.models": 4, "pushjax.filter": 4,
-    "pushjax.train": 5,
+    "pushjax.train": 5, "pushjax.control": 5,
     "pushjax.paper": 6, "pushjax.loop": 6,
 }
 """The layers of ARCHITECTURE.md: a module imports only from lower layers or from its own package."""

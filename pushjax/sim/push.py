@@ -82,7 +82,7 @@ class Recording:
     """One recorded push, every stream sampled on the same 250 Hz clock.
 
     Attributes:
-      params: the push.
+      params: the push (None for a piece of an :class:`Episode`).
       tip_pose: [N, 4] rows [t s, x m, y m, yaw rad (0)].
       object_pose: [M, 4] rows [t s, x m, y m, yaw rad] as recorded (with the tracking effects; M = N unless a
         testbed drops samples).
@@ -92,7 +92,7 @@ class Recording:
         almost every push; see :meth:`Simulator.run`).
     """
 
-    params: PushParams
+    params: PushParams | None
     tip_pose: np.ndarray
     object_pose: np.ndarray
     ft_wrench: np.ndarray
@@ -230,17 +230,7 @@ class Simulator:
         control = np.concatenate([
             target_xy, speed[:, None] * direction, target_xy, np.full((nstep, 1), self._pusher_z)], axis=1)
 
-        mujoco.mj_resetData(model, data)
-        qpos = data.qpos
-        qpos[self._object_qpos:self._object_qpos + 2] = pose[:2] + rotation @ self._settled_object[:2]
-        qpos[self._object_qpos + 2] = self._settled_object[2]
-        quaternion = np.empty(4)
-        mujoco.mju_mulQuat(quaternion, _yaw_quaternion(pose[2]), self._settled_object[3:])
-        qpos[self._object_qpos + 3:self._object_qpos + 7] = quaternion
-        qpos[self._pusher_qpos:self._pusher_qpos + 2] = start
-        data.qvel[self._pusher_qvel:self._pusher_qvel + 2] = pusher_motion(params, np.zeros(1))[1][0] * direction
-        initial_state = np.empty(mujoco.mj_stateSize(model, self._state_spec))
-        mujoco.mj_getState(model, data, initial_state, self._state_spec)
+        initial_state = self._place(pose, start, pusher_motion(params, np.zeros(1))[1][0] * direction)
         if conditions is None:
             states, sensors = rollout.rollout(
                 model, data, initial_state[None], control[None], control_spec=self._control_spec,
@@ -258,25 +248,40 @@ class Simulator:
         tip_pose = np.column_stack([times, sampled[:, self._pusher_qpos:self._pusher_qpos + 2], np.zeros(samples)])
 
         # sensors[k] is computed at the state of time k * timestep: force, torque (at pos), pos.
-        tip_at_step = qpos_path[:-1, self._pusher_qpos:self._pusher_qpos + 2]
-        force = sensors[:, 0:2]
-        lever = sensors[:, 6:8] - tip_at_step
-        moment = sensors[:, 5] + lever[:, 0] * sensors[:, 1] - lever[:, 1] * sensors[:, 0]
-        wrench = np.column_stack([force, moment])
+        wrench = _step_wrench(sensors, qpos_path[:-1, self._pusher_qpos:self._pusher_qpos + 2])
         averaged = np.concatenate([wrench[:1], wrench.reshape(samples - 1, steps_per_sample, 3).mean(axis=1)])
         ft_wrench = np.column_stack([times, averaged])
         return true_pose, tip_pose, ft_wrench
 
-    def _stepped(self, control: np.ndarray, conditions: PushConditions,
+    def _place(self, pose: np.ndarray, pusher: np.ndarray, pusher_velocity: np.ndarray) -> np.ndarray:
+        """Resets ``self.data`` to the settled object at `pose` (x m, y m, yaw rad) and the pusher at `pusher` [2]
+        (m) moving at `pusher_velocity` [2] (m/s), with a zero solver warm start; returns that state (full
+        physics)."""
+        model, data = self.model, self.data
+        mujoco.mj_resetData(model, data)
+        rotation = planar.rotation_matrix(pose[2])
+        qpos = data.qpos
+        qpos[self._object_qpos:self._object_qpos + 2] = pose[:2] + rotation @ self._settled_object[:2]
+        qpos[self._object_qpos + 2] = self._settled_object[2]
+        quaternion = np.empty(4)
+        mujoco.mju_mulQuat(quaternion, _yaw_quaternion(pose[2]), self._settled_object[3:])
+        qpos[self._object_qpos + 3:self._object_qpos + 7] = quaternion
+        qpos[self._pusher_qpos:self._pusher_qpos + 2] = pusher
+        data.qvel[self._pusher_qvel:self._pusher_qvel + 2] = pusher_velocity
+        data.qacc_warmstart[:] = 0.0
+        initial_state = np.empty(mujoco.mj_stateSize(model, self._state_spec))
+        mujoco.mj_getState(model, data, initial_state, self._state_spec)
+        return initial_state
+
+    def _stepped(self, control: np.ndarray, conditions: PushConditions | None,
                  steps_per_update: int) -> tuple[np.ndarray, np.ndarray]:
         """([nstep, nq] qpos after each step, [nstep, nsensordata] sensors at the state before each step) of the
-        push whose initial state ``self.data`` holds, under the coefficients of ``conditions``: the pusher's for
-        the whole push, the supports' set from the object's state every ``steps_per_update`` steps (see the module
-        docstring; the model's coefficients are restored afterwards)."""
+        push whose state ``self.data`` holds, under the coefficients of ``conditions``: the pusher's for the whole
+        push, the supports' set from the object's state every ``steps_per_update`` steps (see the module docstring;
+        the model's coefficients are restored afterwards); None: the model's own coefficients."""
         model, data = self.model, self.data
         nominal = model.pair_friction.copy()
         support_nominal = nominal[self._support_pairs, :2]
-        data.qacc_warmstart[:] = 0.0
         nstep = len(control)
         qpos_steps = np.empty((nstep, model.nq))
         sensors = np.empty((nstep, model.nsensordata))
@@ -286,17 +291,19 @@ class Simulator:
         reach = float(np.linalg.norm(self._support_local, axis=1).max())
         evaluated_at = (math.inf, math.inf, 0.0)  # pose (x m, y m, yaw rad) of the last position factors
         try:
-            pair_friction[self._pusher_pairs, :2] = nominal[self._pusher_pairs, :2] * conditions.pusher_friction
+            if conditions is not None:
+                pair_friction[self._pusher_pairs, :2] = nominal[self._pusher_pairs, :2] * conditions.pusher_friction
             for first_step in range(0, nstep, steps_per_update):
-                pose, speeds = self._support_motion()
-                moved = math.hypot(pose[0] - evaluated_at[0], pose[1] - evaluated_at[1]) + reach * abs(
-                    pose[2] - evaluated_at[2])
-                if moved > FIELD_UPDATE_DISTANCE:
-                    points = planar.rotate(self._support_local, pose[2]) + pose[:2]
-                    position_factors = conditions.position_factors(points, self._support_areas)
-                    evaluated_at = pose
-                factors = position_factors * conditions.speed_factors(speeds)
-                pair_friction[self._support_pairs, :2] = support_nominal * factors[:, None]
+                if conditions is not None:
+                    pose, speeds = self._support_motion()
+                    moved = math.hypot(pose[0] - evaluated_at[0], pose[1] - evaluated_at[1]) + reach * abs(
+                        pose[2] - evaluated_at[2])
+                    if moved > FIELD_UPDATE_DISTANCE:
+                        points = planar.rotate(self._support_local, pose[2]) + pose[:2]
+                        position_factors = conditions.position_factors(points, self._support_areas)
+                        evaluated_at = pose
+                    factors = position_factors * conditions.speed_factors(speeds)
+                    pair_friction[self._support_pairs, :2] = support_nominal * factors[:, None]
                 for k in range(first_step, min(first_step + steps_per_update, nstep)):
                     ctrl[:] = control[k, :4]
                     mujoco.mj_step(model, data)
@@ -322,6 +329,111 @@ class Simulator:
         local_x, local_y = self._support_local.T
         speeds = np.hypot(cos * vx + sin * vy - spin * local_y, cos * vy - sin * vx + spin * local_x)
         return (x, y, yaw), speeds
+
+
+class Episode:
+    """A push of any length along commanded pusher positions, simulated piece by piece as a controller sends them.
+
+    The scene, the stepping and the testbed's coefficients are those of :meth:`Simulator.run` (the stepped path,
+    with or without conditions); the object's and the pusher's states carry over from one :meth:`advance` to the
+    next. The time step is fixed for the episode from ``speed_limit`` as :meth:`Simulator.run` sets it from a push's
+    velocity, and no commanded move may exceed it. Motion capture: the tracking effects and, with ``conditions``,
+    the testbed's noise, jitter and drops of :meth:`pushjax.sim.testbed.PushConditions.track`, drawn for piece ``k``
+    from the conditions' tracking seed extended by ``k`` (the same episode gives the same measurements).
+
+    The episode uses its simulator's ``MjData``: run one episode (or push) of a simulator at a time.
+
+    Args:
+      simulator: the :class:`Simulator` (object, surface, effects).
+      object_pose: (x m, y m, yaw rad) of the object's tracked frame at the start.
+      pusher: (x m, y m) of the pusher at the start (not touching the object).
+      speed_limit: the pusher's largest speed, m/s.
+      rng: random generator of the effects' tracking noise; required when ``effects.tracking_noise`` is non-zero.
+      conditions: the testbed's draw (:func:`pushjax.sim.testbed.draw_conditions`); None: the ideal testbed.
+    """
+
+    def __init__(self, simulator: Simulator, object_pose: Sequence[float], pusher: Sequence[float],
+                 speed_limit: float, rng: np.random.Generator | None = None,
+                 conditions: PushConditions | None = None):
+        pose = np.asarray(object_pose, dtype=np.float64)
+        pusher = np.asarray(pusher, dtype=np.float64)
+        if pose.shape != (3,) or not np.all(np.isfinite(pose)):
+            raise ValueError(f"object_pose: expected finite (x, y, yaw), got {object_pose!r}")
+        if pusher.shape != (2,) or not np.all(np.isfinite(pusher)):
+            raise ValueError(f"pusher: expected finite (x, y), got {pusher!r}")
+        if not (math.isfinite(speed_limit) and speed_limit > 0):
+            raise ValueError(f"speed_limit: expected a speed > 0 m/s, got {speed_limit!r}")
+        if any(simulator.effects.tracking_noise) and rng is None:
+            raise ValueError("rng: required to draw the tracking noise of these effects")
+        if conditions is not None and len(conditions.plate_pressure) != len(simulator._support_pairs):
+            raise ValueError(f"conditions: {len(conditions.plate_pressure)} support values for "
+                             f"{len(simulator._support_pairs)} support points")
+        self.simulator, self.speed_limit, self.rng, self.conditions = simulator, speed_limit, rng, conditions
+        self.steps_per_sample = max(MIN_STEPS_PER_SAMPLE,
+                                    math.ceil(speed_limit * SAMPLE_PERIOD / MAX_STEP_TRAVEL - 1e-9))
+        simulator.model.opt.timestep = SAMPLE_PERIOD / self.steps_per_sample
+        simulator._place(pose, pusher, np.zeros(2))
+        self.pusher = pusher
+        self.samples = 0
+        self.pieces = 0
+
+    @property
+    def time(self) -> float:
+        """Seconds simulated so far."""
+        return self.samples * SAMPLE_PERIOD
+
+    def advance(self, targets: np.ndarray) -> Recording:
+        """Moves the pusher through `targets` [n, 2] (m), one per 4 ms sample, straight and at constant speed from
+        one to the next; returns the piece's :class:`Recording` of the n samples after the start (times from the
+        episode's start; ``params`` None).
+
+        Raises:
+          ValueError: a move faster than the speed limit, or not [n, 2] finite positions.
+        """
+        simulator, data = self.simulator, self.simulator.data
+        targets = np.asarray(targets, dtype=np.float64)
+        if targets.ndim != 2 or targets.shape[1] != 2 or not len(targets) or not np.all(np.isfinite(targets)):
+            raise ValueError(f"targets: expected [n, 2] finite pusher positions, got shape {targets.shape}")
+        moves = np.diff(np.concatenate([self.pusher[None], targets]), axis=0)
+        fastest = float(np.linalg.norm(moves, axis=1).max()) / SAMPLE_PERIOD
+        if fastest > self.speed_limit * (1 + 1e-6):
+            raise ValueError(f"targets: a move at {fastest * 1000:.1f} mm/s exceeds the speed limit "
+                             f"{self.speed_limit * 1000:.1f} mm/s")
+        steps = self.steps_per_sample
+        fractions = np.arange(1, steps + 1) / steps
+        starts = np.concatenate([self.pusher[None], targets[:-1]])
+        position = (starts[:, None] + fractions[None, :, None] * moves[:, None]).reshape(-1, 2)
+        velocity = np.repeat(moves / SAMPLE_PERIOD, steps, axis=0)
+        pusher_columns = slice(simulator._pusher_qpos, simulator._pusher_qpos + 2)
+        tip_before = data.qpos[pusher_columns].copy()
+        qpos_steps, sensors = simulator._stepped(np.concatenate([position, velocity], axis=1), self.conditions, steps)
+        tip_at_step = np.concatenate([tip_before[None], qpos_steps[:-1, pusher_columns]])
+        wrench = _step_wrench(sensors, tip_at_step).reshape(len(targets), steps, 3).mean(axis=1)
+        sampled = qpos_steps[steps - 1::steps]
+        times = (self.samples + np.arange(1, len(targets) + 1)) * SAMPLE_PERIOD
+        first = simulator._object_qpos
+        true_pose = np.column_stack([times, sampled[:, first:first + 2], _yaw(sampled[:, first + 3:first + 7])])
+        tip = sampled[:, pusher_columns]
+        recorded = _tracked(true_pose, simulator.effects, self.rng if any(simulator.effects.tracking_noise) else None)
+        if self.conditions is not None:
+            piece = dataclasses.replace(self.conditions,
+                                        tracking_seed=(*self.conditions.tracking_seed, self.pieces))
+            recorded = piece.track(recorded)
+        self.pusher = targets[-1]
+        self.samples += len(targets)
+        self.pieces += 1
+        return Recording(params=None, tip_pose=np.column_stack([times, tip, np.zeros(len(times))]),
+                         object_pose=recorded, ft_wrench=np.column_stack([times, wrench]),
+                         true_object_pose=true_pose)
+
+
+def _step_wrench(sensors: np.ndarray, tip_at_step: np.ndarray) -> np.ndarray:
+    """[n, 3] (fx N, fy N, torque N·m about the pusher's axis) from the contact sensor's [n, 9] readings (force,
+    torque at pos, pos) and the pusher tip's [n, 2] positions at the same states."""
+    force = sensors[:, 0:2]
+    lever = sensors[:, 6:8] - tip_at_step
+    moment = sensors[:, 5] + lever[:, 0] * sensors[:, 1] - lever[:, 1] * sensors[:, 0]
+    return np.column_stack([force, moment])
 
 
 def implausible_speed(object_pose: np.ndarray, params: PushParams) -> float | None:

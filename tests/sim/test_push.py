@@ -11,6 +11,7 @@ from pushjax.sim import push
 from pushjax.sim.effects import Effects
 from pushjax.sim.push import Simulator, simulate_push
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION, SURFACES
+from pushjax.sim.testbed import REALISTIC, draw_conditions
 
 
 def params(shape="rect1", side=0, point=0.5, angle=0.0, velocity=20.0, acceleration=0.0, surface="abs"):
@@ -230,3 +231,37 @@ def test_tracking_effects_change_the_recorded_poses_only():
     error = noisy.object_pose[:, 1:] - clean.true_object_pose[:, 1:]
     error[:, 2] = np.angle(np.exp(1j * error[:, 2]))
     np.testing.assert_allclose(error.std(axis=0), [1e-3, 1e-3, 0.01], rtol=0.15)
+
+
+def _episode_targets():
+    """[250, 2] pusher positions of a 2 cm push into rect1's -x side along +x at 20 mm/s, from 5 mm away."""
+    return np.column_stack([-0.045 - 0.00476 - 0.005 + 0.02 * np.arange(1, 251) / 250, np.zeros(250)])
+
+
+def test_an_episode_in_pieces_is_the_episode_in_one():
+    simulator = push.simulator("rect1", "abs")
+    targets = _episode_targets()
+    start = (-0.045 - 0.00476 - 0.005, 0.0)
+    whole = push.Episode(simulator, (0.0, 0.0, 0.0), start, 0.04).advance(targets)
+    episode = push.Episode(simulator, (0.0, 0.0, 0.0), start, 0.04)
+    pieces = [episode.advance(targets[:100]), episode.advance(targets[100:])]
+    assert episode.time == pytest.approx(1.0)
+    np.testing.assert_array_equal(np.concatenate([p.true_object_pose for p in pieces]), whole.true_object_pose)
+    assert whole.true_object_pose[-1, 1] > 0.01  # pushed about 1.5 cm
+    np.testing.assert_allclose(whole.tip_pose[:, 1:3], targets, atol=2e-4)
+    assert whole.ft_wrench[-1, 1] > 0.1  # the pusher pushes along +x
+    conditions = draw_conditions(REALISTIC, 0, "rect1", "abs", (0, 1), len(simulator._support_pairs))
+    tracked = push.Episode(simulator, (0.0, 0.0, 0.0), start, 0.04, conditions=conditions).advance(targets)
+    noise = tracked.object_pose[:, 1:3] - tracked.true_object_pose[np.rint(tracked.object_pose[:, 0] * 250).astype(
+        int) - 1, 1:3]
+    assert 0 < np.abs(noise).max() < 6 * REALISTIC.tracking_noise_xy
+
+
+def test_an_episode_refuses_moves_beyond_its_speed_limit():
+    episode = push.Episode(push.simulator("rect1", "abs"), (0.0, 0.0, 0.0), (-0.1, 0.0), 0.02)
+    with pytest.raises(ValueError, match="speed limit"):
+        episode.advance(np.array([[-0.1 + 0.0001, 0.0]]))  # 25 mm/s
+    with pytest.raises(ValueError, match="targets"):
+        episode.advance(np.zeros((0, 2)))
+    with pytest.raises(ValueError, match="speed_limit"):
+        push.Episode(push.simulator("rect1", "abs"), (0.0, 0.0, 0.0), (-0.1, 0.0), 0.0)

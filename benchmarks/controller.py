@@ -1,0 +1,48 @@
+"""Speed of the push-to-goal controller (``pushjax.control.mpc.replan``): plans per second on CPU.
+
+One plan is one ``replan`` call with the default ``ControllerConfig`` (horizon 12, 32 candidate contacts × 5
+directions × 4 push lengths scored, the planner's own iterations: gradient 30 Adam steps through the rollout,
+sampling 4 × 64 cross-entropy samples), from rect1-like states: the object at the origin, the pusher touching its
+-x side, a goal 10 cm away turned by 45°. Prints a markdown table of the first (compiling) call and the median
+(best) of ``--repeats`` calls.
+
+    python benchmarks/controller.py [--objects=rect1,ellip2,butter] [--planners=gradient,sampling] [--repeats=20]
+"""
+
+import platform
+
+import jax
+import jax.numpy as jnp
+from absl import app, flags
+
+from pushjax.control import model, mpc
+from pushjax.geometry.objects import PUSHER_RADIUS, get_object
+from timing import time_calls
+
+_OBJECTS = flags.DEFINE_list("objects", ["rect1", "ellip2", "butter"], "Objects to measure.")
+_PLANNERS = flags.DEFINE_list("planners", list(mpc.PLANNERS), "Planners to measure.")
+_REPEATS = flags.DEFINE_integer("repeats", 20, "Timed calls per measurement.")
+
+
+def main(argv):
+    del argv
+    print(f"{platform.processor() or platform.machine()}, {jax.devices()[0].platform}, jax {jax.__version__}; "
+          f"default ControllerConfig, float32, median (best) of {_REPEATS.value}\n")
+    print("| object | planner | first call (s) | time per plan (ms) | plans/s |")
+    print("|---|---|---:|---:|---:|")
+    for name in _OBJECTS.value:
+        push_model = model.make_model(name)
+        left = float(get_object(name).outline[:, 0].min())
+        pusher = jnp.array([left - PUSHER_RADIUS - 1e-3, 0.0])
+        goal = jnp.array([0.1, 0.0, 0.785])
+        for planner in _PLANNERS.value:
+            config = mpc.ControllerConfig(planner=planner)
+            state = mpc.init(config, jax.random.key(0))
+            first, median, best = time_calls(
+                lambda: mpc.replan(config, push_model, state, jnp.zeros(3), pusher, goal), _REPEATS.value)
+            print(f"| {name} | {planner} | {first:.1f} | {1e3 * median:.1f} ({1e3 * best:.1f}) | {1 / median:.1f} "
+                  f"({1 / best:.1f}) |")
+
+
+if __name__ == "__main__":
+    app.run(main)

@@ -1,0 +1,95 @@
+r"""Push objects to goal poses with model-predictive control, closed on the MuJoCo testbed.
+
+  python -m experiments.push_to_goal --workdir=work/push_to_goal [--scale=smoke|cpu|full] [--objects=rect1,...]
+      [--goals=N] [--models=lynch,lynch+friction_ratio] [--effect_params='friction_ratio.log_scale=0.3']
+      [--planners=gradient,sampling] [--seed=0] [--surface=abs] [--testbed=realistic|ideal]
+      [--testbed_overrides='drop_rate=0'] [--effects='table_tilt_deg=2'] [--max_time=60]
+
+Draws the goals (``pushjax.control.goals``), runs every model and planner on each (``pushjax.control.push_to_goal``,
+resumable from ``--workdir``/episodes.jsonl) and writes ``results.json``, ``results.md`` and ``trajectories.png``.
+"""
+
+import math
+
+from absl import app, flags
+
+import experiments
+from pushjax.control import closed_loop, mpc, push_to_goal, report
+from pushjax.geometry.objects import OBJECT_NAMES
+from pushjax.sim.effects import Effects
+from pushjax.sim.surfaces import SURFACE_NAMES
+
+_WORKDIR = flags.DEFINE_string("workdir", None, "Folder for episodes.jsonl, results.json, results.md, the figure.",
+                               required=True)
+_SCALE = flags.DEFINE_enum("scale", "cpu", list(push_to_goal.SCALES), "Objects, goals and planners (smoke: a test).")
+_OBJECTS = flags.DEFINE_list("objects", None, "Objects (default: the scale's).")
+_GOALS = flags.DEFINE_integer("goals", None, "Goals per object (default: the scale's).", lower_bound=1)
+_MODELS = flags.DEFINE_list("models", ["lynch"], "Models: lynch or lynch+<effect>+... (pushjax.physics.effects).")
+_EFFECT_PARAMS = flags.DEFINE_string("effect_params", "", "The models' effect parameters, effect.parameter=value;...")
+_PLANNERS = flags.DEFINE_list("planners", None, f"Planners from {','.join(mpc.PLANNERS)} (default: the scale's).")
+_SEED = flags.DEFINE_integer("seed", 0, "Seed of the goals, the testbed's draws and the planners.", lower_bound=0)
+_SURFACE = flags.DEFINE_enum("surface", "abs", list(SURFACE_NAMES), "Surface the objects are pushed on.")
+_TESTBED = experiments.define_testbed_flag()
+_TESTBED_OVERRIDES = flags.DEFINE_string("testbed_overrides", "", "Testbed magnitudes to change, e.g. 'drop_rate=0'.")
+_EFFECTS = flags.DEFINE_string("effects", "", "Effects of the simulated world, e.g. 'table_tilt_deg=2'.")
+_MAX_TIME = flags.DEFINE_float("max_time", None, "Simulated seconds per goal (default: the scale's).", lower_bound=1)
+experiments.require_writable_folder("workdir")
+
+
+@flags.validator("max_time", "expected a finite number of seconds >= 1")
+def _check_max_time(value):
+    return value is None or math.isfinite(value)
+
+
+@flags.validator("objects", f"expected a non-empty list from {','.join(OBJECT_NAMES)}, no repeats")
+def _check_objects(values):
+    return values is None or (bool(values) and len(set(values)) == len(values) and set(values) <= set(OBJECT_NAMES))
+
+
+@flags.validator("planners", f"expected a non-empty list from {','.join(mpc.PLANNERS)}, no repeats")
+def _check_planners(values):
+    return values is None or (bool(values) and len(set(values)) == len(values) and set(values) <= set(mpc.PLANNERS))
+
+
+def _parsed_by(parse):
+    """A flag checker that raises parse's one-line error as the flag's."""
+
+    def check(value):
+        try:
+            parse(value)
+        except ValueError as error:
+            raise flags.ValidationError(str(error)) from None
+        return True
+
+    return check
+
+
+def _parse_models(names):
+    if not names:
+        raise ValueError("expected at least one model")
+    return [push_to_goal.model_effects(name) for name in names]
+
+
+flags.register_validator("models", _parsed_by(_parse_models))
+flags.register_validator("effect_params", _parsed_by(push_to_goal.parse_effect_params))
+flags.register_validator("effects", _parsed_by(Effects.parse))
+
+
+def main(argv):
+    if len(argv) > 1:
+        raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
+    testbed = experiments.testbed_from_flags(_TESTBED.value, _TESTBED_OVERRIDES.value)
+    scale = push_to_goal.SCALES[_SCALE.value]
+    loop = closed_loop.LoopConfig(max_time=_MAX_TIME.value or scale["max_time"], surface=_SURFACE.value,
+                                  testbed=testbed, effects=Effects.parse(_EFFECTS.value))
+    results = push_to_goal.run(_WORKDIR.value, _OBJECTS.value or scale["objects"], _GOALS.value or scale["goals"],
+                               _MODELS.value, _PLANNERS.value or scale["planners"], _SEED.value, loop,
+                               _EFFECT_PARAMS.value)
+    results["settings"]["scale"] = _SCALE.value
+    paths = report.write(results, _WORKDIR.value)
+    print(paths[1].read_text())
+    print(f"wrote {', '.join(str(path) for path in paths)}")
+
+
+if __name__ == "__main__":
+    experiments.run(main)

@@ -1,0 +1,79 @@
+"""The pushing model a controller plans with: an object's outline and Lynch's model with any composed effects.
+
+:class:`PushModel` is a pytree (``effects`` static), so a controller jit-compiled once per set of effect names
+takes any object, ``l``, ``mu`` and effect parameters without compiling again. :func:`predict` is the rollout of
+:mod:`pushjax.physics.rollout` along a pusher path.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import flax.struct
+import jax
+import jax.numpy as jnp
+
+from pushjax.geometry import outline_jax
+from pushjax.geometry.objects import PUSHER_RADIUS, PushObject, get_object, limit_surface_ratio
+from pushjax.physics import effects as effects_lib
+from pushjax.physics import rollout
+
+__all__ = ["PushModel", "make_model", "predict"]
+
+
+@flax.struct.dataclass
+class PushModel:
+    """One object and the pushing model the controller believes in.
+
+    Attributes:
+      shape: the object's outline (:func:`pushjax.geometry.outline_jax.outline`).
+      l: [] limit-surface ratio, m.
+      mu: [] pusher-object friction coefficient.
+      radius: [] pusher radius, m.
+      params: {effect: {name: array}} of the composed effects ({} for plain Lynch).
+      effects: names of the composed effects (static; () is plain Lynch).
+    """
+
+    shape: outline_jax.Outline
+    l: jax.Array
+    mu: jax.Array
+    radius: jax.Array
+    params: dict
+    effects: tuple[str, ...] = flax.struct.field(pytree_node=False, default=())
+
+
+def make_model(obj: PushObject | str, mu: float = 0.25, l: float | None = None, *, effects: Sequence[str] = (),
+               params: dict | None = None, dtype=jnp.float32) -> PushModel:
+    """The :class:`PushModel` of `obj` (or its name).
+
+    Args:
+      obj: the object.
+      mu: pusher-object friction coefficient (> 0).
+      l: limit-surface ratio, m (default: uniform pressure, :func:`pushjax.geometry.objects.limit_surface_ratio`).
+      effects: effect names of :data:`pushjax.physics.effects.EFFECTS` composed with Lynch's model.
+      params: their parameters, {effect: {name: value}}; missing effects take their "no effect" values.
+      dtype: float dtype of the arrays.
+    """
+    obj = get_object(obj) if isinstance(obj, str) else obj
+    l = limit_surface_ratio(obj) if l is None else l
+    if not (jnp.isfinite(mu) and mu > 0 and jnp.isfinite(l) and l > 0):
+        raise ValueError(f"mu, l: expected positive finite values, got {mu}, {l}")
+    effects = tuple(effects)
+    full = effects_lib.init_params(effects)
+    unknown = sorted(set(params or {}) - set(full))
+    if unknown:
+        raise ValueError(f"params: effect(s) {', '.join(unknown)} not among the composed effects {effects}")
+    for name, values in (params or {}).items():
+        extra = sorted(set(values) - set(full[name]))
+        if extra:
+            raise ValueError(f"params: {name} has no parameter(s) {', '.join(extra)}; it has {', '.join(full[name])}")
+        full[name] = {**full[name], **values}
+    full = jax.tree_util.tree_map(lambda value: jnp.asarray(value, dtype), full)
+    return PushModel(shape=outline_jax.outline(obj, dtype), l=jnp.asarray(l, dtype), mu=jnp.asarray(mu, dtype),
+                     radius=jnp.asarray(PUSHER_RADIUS, dtype), params=full, effects=effects)
+
+
+def predict(model: PushModel, pose, pusher_path) -> rollout.Rollout:
+    """The model's rollout from `pose` [3] (x m, y m, yaw rad) along `pusher_path` [T + 1, 2] (world, m)."""
+    return rollout.rollout(model.shape, pose, pusher_path, model.l, model.mu, model.params, effects=model.effects,
+                           radius=model.radius)

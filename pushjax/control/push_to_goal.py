@@ -1,0 +1,143 @@
+"""The push-to-goal experiment (``python -m experiments.push_to_goal``): every model and planner pushes every
+object to its goals on the testbed, closed loop.
+
+Models are named ``lynch`` (plain Lynch) or ``lynch+<effect>+...`` (Lynch with effects of
+:data:`pushjax.physics.effects.EFFECTS`), their parameters set by ``effect.parameter=value`` items
+(:func:`parse_effect_params`; unset parameters keep their "no effect" values). Each model plans with the testbed's
+nominal pusher friction and the uniform-pressure limit-surface ratio. Episodes are appended to
+``episodes.jsonl`` in the work folder as they finish, keyed by the run's settings, so an interrupted run resumes
+where it stopped; :mod:`pushjax.control.report` turns the rows into ``results.json``, a table and a figure.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import tqdm
+
+from pushjax.control import closed_loop, goals, mpc, report
+from pushjax.control.model import make_model
+from pushjax.geometry.objects import OBJECT_NAMES
+from pushjax.physics import effects as effects_lib
+from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
+
+__all__ = ["SCALES", "model_effects", "parse_effect_params", "run"]
+
+SCALES = {
+    "smoke": {"objects": ("rect1",), "goals": 2, "planners": ("gradient",), "max_time": 30.0},
+    "cpu": {"objects": OBJECT_NAMES, "goals": 2, "planners": ("gradient", "sampling"), "max_time": 60.0},
+    "full": {"objects": OBJECT_NAMES, "goals": 10, "planners": ("gradient", "sampling"), "max_time": 60.0},
+}
+"""Objects, goals per object, planners and simulated seconds per episode of each scale."""
+TRAJECTORY_STRIDE = 5
+"""Control periods between the poses kept for the figure."""
+
+
+def model_effects(name: str) -> tuple[str, ...]:
+    """The effects of the model called `name` (``lynch`` or ``lynch+effect+...``).
+
+    Raises:
+      ValueError: not of that form, an unknown effect or effects that do not compose; one line.
+    """
+    parts = name.split("+")
+    if parts[0] != "lynch" or any(not part for part in parts):
+        raise ValueError(f"model {name!r}: expected 'lynch' or 'lynch+<effect>+...'")
+    effects = tuple(parts[1:])
+    effects_lib.init_params(effects)
+    needs_support = [effect for effect in effects if effects_lib.EFFECTS[effect].solve is not None]
+    if needs_support:
+        raise ValueError(f"model {name!r}: {', '.join(needs_support)} needs the support's points, which the rollout "
+                         f"does not pass; use effects of {', '.join(effects_lib.ELLIPSOID_EFFECTS)}")
+    return effects
+
+
+def parse_effect_params(spec: str) -> dict[str, dict[str, np.ndarray]]:
+    """{effect: {parameter: value}} from ``effect.parameter=value[,value];...`` (vectors comma-separated).
+
+    Raises:
+      ValueError: a malformed item, an unknown effect or parameter, or a value of the wrong size; one line.
+    """
+    params: dict[str, dict[str, np.ndarray]] = {}
+    for item in filter(None, (part.strip() for part in spec.split(";"))):
+        target, equals, value = item.partition("=")
+        effect, dot, parameter = target.strip().partition(".")
+        if not (equals and dot and effect and parameter):
+            raise ValueError(f"{item!r}: expected effect.parameter=value")
+        if effect not in effects_lib.EFFECTS:
+            raise ValueError(f"{item!r}: unknown effect {effect!r}; known: {', '.join(effects_lib.EFFECT_NAMES)}")
+        init = effects_lib.EFFECTS[effect].init()
+        if parameter not in init:
+            raise ValueError(f"{item!r}: {effect} has no parameter {parameter!r}; it has {', '.join(init)}")
+        try:
+            number = np.array([float(v) for v in value.split(",")], np.float64)
+        except ValueError:
+            raise ValueError(f"{item!r}: expected numbers, got {value!r}") from None
+        expected = np.shape(init[parameter])
+        number = number.reshape(()) if expected == () and number.size == 1 else number
+        if number.shape != expected or not np.all(np.isfinite(number)):
+            raise ValueError(f"{item!r}: expected {max(1, int(np.prod(expected)))} finite number(s)")
+        params.setdefault(effect, {})[parameter] = number
+    return params
+
+
+def _fingerprint(settings: dict) -> str:
+    return hashlib.sha256(json.dumps(settings, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
+def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, models: Sequence[str],
+        planners: Sequence[str], seed: int, loop: closed_loop.LoopConfig, effect_params: str = "",
+        controller: mpc.ControllerConfig = mpc.ControllerConfig()) -> dict:
+    """Runs every model and planner on every goal (resuming from ``workdir/episodes.jsonl``); returns the
+    results of :func:`pushjax.control.report.summarise`.
+
+    Args:
+      workdir: the work folder (created).
+      objects: object names.
+      goals_per_object: goals per object (:func:`pushjax.control.goals.draw_goals`).
+      models: model names (:func:`model_effects`).
+      planners: planner names (:data:`pushjax.control.mpc.PLANNERS`).
+      seed: seed of the goals, the testbed's draws and the controllers' keys.
+      loop: the :class:`~pushjax.control.closed_loop.LoopConfig` (testbed, world, surface, limits).
+      effect_params: the models' effect parameters (:func:`parse_effect_params`).
+      controller: the controller's settings (``planner`` replaced by each of `planners`).
+    """
+    params = parse_effect_params(effect_params)
+    model_specs = {name: model_effects(name) for name in models}
+    tasks = goals.draw_goals(objects, goals_per_object, seed)
+    settings = {"seed": seed, "loop": dataclasses.asdict(loop), "effect_params": effect_params,
+                "controller": repr(controller)}
+    fingerprint = _fingerprint(settings)
+    workdir = Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    log = workdir / "episodes.jsonl"
+    done = {}
+    if log.exists():
+        for line in log.read_text().splitlines():
+            row = json.loads(line)
+            if row["fingerprint"] == fingerprint:
+                done[(row["model"], row["planner"], row["object"], row["index"])] = row
+    rows = []
+    jobs = [(name, planner, task) for name in models for planner in planners for task in tasks]
+    with log.open("a") as out:
+        for name, planner, task in tqdm.tqdm(jobs, desc="push_to_goal", unit="goal"):
+            key = (name, planner, task.obj, task.index)
+            if key in done:
+                rows.append(done[key])
+                continue
+            effects = model_specs[name]
+            model = make_model(task.obj, mu=PUSHER_OBJECT_FRICTION, effects=effects,
+                               params={effect: values for effect, values in params.items() if effect in effects})
+            config = dataclasses.replace(controller, planner=planner)
+            result = closed_loop.run_episode(model, config, task.obj, task.start, task.goal, seed=seed,
+                                             index=task.index, loop=loop)
+            row = {"fingerprint": fingerprint, "model": name, "planner": planner, "object": task.obj,
+                   "index": task.index, **report.episode_row(task, result, TRAJECTORY_STRIDE)}
+            out.write(json.dumps(row) + "\n")
+            out.flush()
+            rows.append(row)
+    return report.summarise(rows, settings)

@@ -1,0 +1,129 @@
+"""The push-to-goal report: per episode rows, summaries per model and planner (and per object) with Wilson
+intervals, ``results.json``, a markdown table and a figure of trajectories.
+
+Units in the report: mm and degrees for errors, m for the pusher's path, s for times.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from pushjax import planar
+from pushjax.control import goals
+from pushjax.geometry.objects import PUSHER_RADIUS, get_object
+
+__all__ = ["episode_row", "figure", "summarise", "table", "write"]
+
+
+def episode_row(task: goals.Goal, result, stride: int) -> dict:
+    """The JSON row of one episode (a :class:`pushjax.control.closed_loop.EpisodeResult`): errors, success, path,
+    times, and the trajectory every `stride` control periods (and the last)."""
+    keep = np.unique(np.append(np.arange(0, len(result.poses), stride), len(result.poses) - 1))
+    return {
+        "start": list(task.start), "goal": list(task.goal), "final_pose": result.final_pose.tolist(),
+        "position_error_mm": 1e3 * result.position_error, "yaw_error_deg": math.degrees(result.yaw_error),
+        "success": goals.succeeded(result.position_error, result.yaw_error), "path_length_m": result.path_length,
+        "time_s": result.time, "wall_s": result.wall_time, "plans": result.plans, "repositions": result.repositions,
+        "stop": result.stop, "trajectory": {"poses": result.poses[keep].tolist(), "pusher": result.pusher[keep].tolist()},
+    }
+
+
+def _summary(rows: Sequence[dict]) -> dict:
+    successes = sum(row["success"] for row in rows)
+    low, high = goals.wilson_interval(successes, len(rows))
+    position = np.array([row["position_error_mm"] for row in rows])
+    yaw = np.abs([row["yaw_error_deg"] for row in rows])
+    return {
+        "goals": len(rows), "successes": successes, "success_rate": successes / len(rows),
+        "wilson_95": [low, high], "position_error_mm_median": float(np.median(position)),
+        "position_error_mm_mean": float(np.mean(position)), "yaw_error_deg_median": float(np.median(yaw)),
+        "yaw_error_deg_mean": float(np.mean(yaw)),
+        "path_length_m_mean": float(np.mean([row["path_length_m"] for row in rows])),
+        "time_s_mean": float(np.mean([row["time_s"] for row in rows])),
+        "wall_s_mean": float(np.mean([row["wall_s"] for row in rows])),
+        "stops": {stop: sum(row["stop"] == stop for row in rows) for stop in sorted({row["stop"] for row in rows})},
+    }
+
+
+def summarise(rows: Sequence[dict], settings: dict) -> dict:
+    """``{"criterion", "settings", "summary": {model/planner: ...}, "per_object": {model/planner: {object: ...}},
+    "episodes": rows}``."""
+    groups: dict[str, list[dict]] = {}
+    for row in rows:
+        groups.setdefault(f"{row['model']}/{row['planner']}", []).append(row)
+    per_object = {}
+    for name, members in groups.items():
+        objects = sorted({row["object"] for row in members})
+        per_object[name] = {obj: _summary([row for row in members if row["object"] == obj]) for obj in objects}
+    return {"criterion": {"position_mm": 1e3 * goals.SUCCESS_POSITION, "yaw_deg": goals.SUCCESS_YAW_DEG},
+            "settings": settings, "summary": {name: _summary(members) for name, members in groups.items()},
+            "per_object": per_object, "episodes": list(rows)}
+
+
+def _line(label: str, entry: dict) -> str:
+    low, high = entry["wilson_95"]
+    return (f"| {label} | {entry['successes']}/{entry['goals']} | {100 * entry['success_rate']:.0f} % "
+            f"[{100 * low:.0f}, {100 * high:.0f}] | {entry['position_error_mm_median']:.1f} | "
+            f"{entry['yaw_error_deg_median']:.1f} | {entry['path_length_m_mean']:.2f} | {entry['time_s_mean']:.1f} | "
+            f"{entry['wall_s_mean']:.1f} |")
+
+
+def table(results: dict) -> str:
+    """Markdown: one row per model/planner, then one per model/planner and object."""
+    criterion = results["criterion"]
+    header = ("| {} | successes | success rate [Wilson 95 %] | median position error (mm) | median orientation error "
+              "(deg) | mean pusher path (m) | mean time (s) | mean wall time (s) |\n|---|---:|---:|---:|---:|---:|---:|---:|")
+    lines = [f"Success: final position error < {criterion['position_mm']:g} mm and orientation error < "
+             f"{criterion['yaw_deg']:g} deg.", "", header.format("model / planner")]
+    lines += [_line(name, entry) for name, entry in results["summary"].items()]
+    lines += ["", header.format("model / planner, object")]
+    lines += [_line(f"{name}, {obj}", entry) for name, objects in results["per_object"].items()
+              for obj, entry in objects.items()]
+    return "\n".join(lines) + "\n"
+
+
+def figure(results: dict, path: Path, count: int = 4) -> None:
+    """A few episodes: the object's outline over time (light to dark), the goal (dashed), the pusher's path."""
+    episodes = results["episodes"][:count]
+    axes = plt.subplots(1, len(episodes), figsize=(3.4 * len(episodes), 3.4), squeeze=False)[1][0]
+    drawing = axes[0].figure
+    for axis, row in zip(axes, episodes):
+        outline = get_object(row["object"]).outline
+        poses = np.asarray(row["trajectory"]["poses"])
+        for shade, pose in zip(np.linspace(0.2, 1.0, len(poses)), poses):
+            points = pose[1:3] + planar.rotate(outline, pose[3])
+            axis.fill(*points.T, color=plt.cm.Blues(shade), alpha=0.35, linewidth=0.5, edgecolor="k")
+        goal = np.asarray(row["goal"])
+        goal_points = goal[:2] + planar.rotate(outline, goal[2])
+        axis.plot(*np.vstack([goal_points, goal_points[:1]]).T, "r--", linewidth=1.2, label="goal")
+        pusher = np.asarray(row["trajectory"]["pusher"])
+        axis.plot(pusher[:, 1], pusher[:, 2], "-", color="0.3", linewidth=0.8, label="pusher")
+        axis.plot(*pusher[-1, 1:3], "o", color="0.3", markersize=2 * 1e3 * PUSHER_RADIUS / 3)
+        axis.set_aspect("equal")
+        axis.set_title(f"{row['object']} #{row['index']} ({row['model']}/{row['planner']})\n"
+                       f"{row['position_error_mm']:.1f} mm, {row['yaw_error_deg']:.1f} deg", fontsize=8)
+        axis.tick_params(labelsize=7)
+    axes[0].legend(fontsize=7, loc="best")
+    drawing.tight_layout()
+    drawing.savefig(path, dpi=100)
+    plt.close(drawing)
+
+
+def write(results: dict, workdir: str | Path) -> list[Path]:
+    """Writes ``results.json``, ``results.md`` and ``trajectories.png`` to `workdir`; returns their paths."""
+    workdir = Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    paths = [workdir / "results.json", workdir / "results.md", workdir / "trajectories.png"]
+    paths[0].write_text(json.dumps(results, indent=1))
+    paths[1].write_text(table(results))
+    figure(results, paths[2])
+    return paths

@@ -1,0 +1,33 @@
+"""The report: summaries per model/planner and object with Wilson intervals, the table and the figure."""
+
+import json
+
+import numpy as np
+
+from pushjax.control import goals, report
+
+
+def _row(model, obj, index, position_mm, yaw_deg):
+    poses = np.array([[0.0, 0.0, 0.0, 0.0], [1.0, 0.05, 0.0, 0.2]])
+    return {"model": model, "planner": "gradient", "object": obj, "index": index, "start": [0.0, 0.0, 0.0],
+            "goal": [0.05, 0.0, 0.2], "final_pose": [0.05, 0.0, 0.2], "position_error_mm": position_mm,
+            "yaw_error_deg": yaw_deg, "success": goals.succeeded(position_mm / 1e3, np.radians(yaw_deg)),
+            "path_length_m": 0.3, "time_s": 10.0, "wall_s": 2.0, "plans": 20, "repositions": 2, "stop": "reached",
+            "trajectory": {"poses": poses.tolist(), "pusher": [[0.0, -0.06, 0.0], [1.0, -0.01, 0.0]]}}
+
+
+def test_summaries_tables_and_figure(tmp_path):
+    rows = [_row("lynch", "rect1", 0, 1.0, 0.5), _row("lynch", "rect1", 1, 7.0, 0.5),
+            _row("lynch", "tri2", 0, 2.0, -6.0), _row("lynch+friction_ratio", "rect1", 0, 1.0, 1.0)]
+    results = report.summarise(rows, {"seed": 0})
+    lynch = results["summary"]["lynch/gradient"]
+    assert (lynch["goals"], lynch["successes"]) == (3, 1)
+    np.testing.assert_allclose(lynch["wilson_95"], goals.wilson_interval(1, 3))
+    assert lynch["position_error_mm_median"] == 2.0 and lynch["yaw_error_deg_median"] == 0.5
+    assert results["per_object"]["lynch/gradient"]["rect1"]["successes"] == 1
+    assert results["criterion"] == {"position_mm": 5.0, "yaw_deg": 5.0}
+    paths = report.write(results, tmp_path)
+    assert json.loads(paths[0].read_text())["summary"]["lynch/gradient"]["goals"] == 3
+    text = paths[1].read_text()
+    assert "| lynch/gradient | 1/3 | 33 % [6, 79] |" in text and "| lynch/gradient, tri2 | 0/1 |" in text
+    assert paths[2].stat().st_size > 5000
