@@ -18,12 +18,15 @@ REPOSITORY = Path(__file__).resolve().parents[1]
 CASE_TIMEOUT_S = 60
 PARALLEL = 3
 
+LIBRARIES = ("experiments, pushjax.data, pushjax.loop, pushjax.paper.findings, pushjax.paper.figures, "
+             "pushjax.paper.runner, pushjax.paper.spec, pushjax.paper.tables, pushjax.paper.visualize, "
+             "pushjax.physics.demo, pushjax.sim.dataset, pushjax.control.push_to_goal")
+"""What the binaries import, bar the binaries themselves (each defines flags): a server imports it once and forks."""
+
 # The server: imports the libraries (not the binaries, which define the flags), then forks one child per case.
 SERVER = r"""
 import contextlib, json, os, runpy, signal, sys, time
-import experiments, pushjax.data, pushjax.loop, pushjax.paper.findings, pushjax.paper.figures, pushjax.paper.runner
-import pushjax.paper.spec, pushjax.paper.tables, pushjax.paper.visualize, pushjax.physics.demo, pushjax.sim.dataset
-import pushjax.control.push_to_goal
+import """ + LIBRARIES + r"""
 
 
 def run_as_main(binary):

@@ -94,7 +94,7 @@ def _compiled_step(
     Args:
       model_config: the models' architecture and variant.
       physics: replaces `PushModel.physics`, or None for the default.
-      optimizer_settings: (learning rate, schedule, number of steps) of `make_optimizer`.
+      optimizer_settings: (learning rate, schedule, number of steps or None) of `make_optimizer`.
       weight_decay: weight of the loss's weight penalty.
       mode: one of `SWEEP_MODES`.
       per_model_options: whether the step takes [K, 2] per-model error-term flags (else None).
@@ -212,7 +212,9 @@ def sweep(
                          "'vmap' or 'unroll'")
     model_config = train_config.model
     model = PushModel(model_config) if physics is None else PushModel(model_config, physics)
-    optimizer_settings = (train_config.learning_rate, train_config.schedule, train_config.num_steps)
+    # The constant schedule does not depend on the number of steps: sweeps of any length share a compiled step.
+    decay_steps = train_config.num_steps if train_config.schedule != "constant" else None
+    optimizer_settings = (train_config.learning_rate, train_config.schedule, decay_steps)
     optimizer = make_optimizer(*optimizer_settings)
     options = _error_options(model_config, specs)
     mesh = None if mode == "sequential" else mesh_lib.sweep_mesh(len(specs))

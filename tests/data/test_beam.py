@@ -38,13 +38,15 @@ def _records(builder: PushEffects) -> dict[str, list[bytes]]:
     return records
 
 
-def test_beam_build_has_the_process_pool_records(tmp_path):
+def test_beam_build_has_the_process_pool_records(smoke_data, tmp_path):
     # `objects` at smoke scale: 25 sequences in 6 splits, the 4 training splits sharing sequences. The Beam build
-    # reads the sequences the process pool simulated, and cuts splits into 2 shards by key (the pool writes 1).
+    # reads the sequences the process pool simulated (the suite's smoke dataset, built by `build` with one
+    # worker), and cuts splits into 2 shards by key (the pool writes 1).
     tfds.disable_progress_bar()
-    pool = build("objects", "smoke", data_dir=tmp_path / "pool", workers=1, progress=False)
+    pool_dir = smoke_data("objects")
+    pool = build("objects", "smoke", data_dir=pool_dir, workers=1, progress=False)
     beam = PushEffects(config="objects_smoke", data_dir=tmp_path / "beam",
-                       raw_dir=tmp_path / "pool" / "push_effects_raw" / "realistic" / "seed0")
+                       raw_dir=pool_dir / "push_effects_raw" / "realistic" / "seed0")
     beam.download_and_prepare(download_config=tfds.download.DownloadConfig(beam_runner="DirectRunner", num_shards=2))
     assert max(len(split.shard_lengths) for split in beam.info.splits.values()) == 2
     assert {name: split.num_examples for name, split in pool.info.splits.items()} == {

@@ -3,7 +3,9 @@
 import datetime
 import json
 import logging
+import shutil
 
+from pushjax.data.builder import RAW_DIR_NAME
 from pushjax.paper import runner
 from pushjax.paper import spec as spec_lib
 from pushjax.train import describe_specs, subset_specs
@@ -20,7 +22,9 @@ def test_load_splits_says_which_dataset_it_reused(smoke_data, caplog):
     assert str(data_dir) in message
 
 
-def test_load_splits_says_where_it_built_a_dataset(tmp_path, caplog):
+def test_load_splits_says_where_it_built_a_dataset(smoke_data, tmp_path, caplog):
+    # The suite's simulated pushes in the raw cache, so that the build only renders and writes the examples.
+    shutil.copytree(smoke_data("objects") / RAW_DIR_NAME, tmp_path / RAW_DIR_NAME)
     spec = spec_lib.make_spec(spec_lib.SETUPS["objects"], "smoke", data_dir=tmp_path)
     with caplog.at_level(logging.INFO, logger="absl"):
         runner.load_splits(spec, spec.dataset, progress=False)

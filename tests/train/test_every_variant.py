@@ -2,6 +2,7 @@
 (its own file: the longest of the trainer's tests, run beside the others on another pytest-xdist worker)."""
 
 import csv
+import dataclasses
 
 import jax
 import numpy as np
@@ -15,6 +16,8 @@ from tests.tiny_configs import TINY_SMOKE as SMOKE
 ERROR_VARIANTS = ("error", "error_grad", "error_norm")
 VARIANT_SWEEPS = [(variant,) for variant in VARIANTS if variant not in ERROR_VARIANTS] + [ERROR_VARIANTS]
 """Every variant once; the three error variants share one model and so one sweep (per-model error options)."""
+NUM_STEPS = 100
+"""Half the smoke config's: every variant lowers its loss by at least 30 % in it (by 49-79 % on 2026-11-26)."""
 
 
 @pytest.mark.parametrize("variants, view", [(variants, "top_down") for variants in VARIANT_SWEEPS] + [(("hybrid",), "free")])
@@ -25,17 +28,17 @@ def test_every_variant_learns_without_nan(variants, view, smoke, smoke_viewpoint
     specs = train.subset_specs(size, [size], [0], variants if len(variants) > 1 else (None,))
     losses = []
     result = train.sweep(
-        SMOKE.with_variant(variants[0], view), examples, specs, tmp_path, progress=False,
-        step_callback=lambda step, metrics: losses.append(np.asarray(metrics["loss"])),
+        dataclasses.replace(SMOKE.with_variant(variants[0], view), num_steps=NUM_STEPS), examples, specs, tmp_path,
+        progress=False, step_callback=lambda step, metrics: losses.append(np.asarray(metrics["loss"])),
     )
     losses = np.stack(losses)  # [steps, models]
-    assert losses.shape == (200, len(variants)) and np.all(np.isfinite(losses))
+    assert losses.shape == (NUM_STEPS, len(variants)) and np.all(np.isfinite(losses))
     assert all(np.all(np.isfinite(leaf)) for leaf in jax.tree.leaves(result.state))
     assert np.all(losses[-20:].mean(0) <= 0.7 * losses[:5].mean(0)), (losses[:5], losses[-20:])
     with (tmp_path / "metrics.csv").open() as file:
         rows = list(csv.DictReader(file))
-    assert sorted({int(row["step"]) for row in rows}) == list(range(20, 201, 20))
-    assert len(rows) == 10 * len(variants)
+    assert sorted({int(row["step"]) for row in rows}) == list(range(20, NUM_STEPS + 1, 20))
+    assert len(rows) == NUM_STEPS // 20 * len(variants)
     for metrics in evaluate.evaluate_sweep(result, splits["test"], batch_size=64):
         assert np.isfinite(metrics["trans_percent"]) and np.isfinite(metrics["rot_percent"])
-    np.testing.assert_array_equal(result.steps_trained, [200] * len(variants))
+    np.testing.assert_array_equal(result.steps_trained, [NUM_STEPS] * len(variants))
