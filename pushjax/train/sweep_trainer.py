@@ -29,7 +29,8 @@ resumed from a checkpoint replays exactly the batches of an uninterrupted run an
 parameters, and a model trained alone draws the same batches as inside a sweep.
 
 Work directory layout: ``checkpoints/<step>/`` (orbax, `pushjax.train.checkpoint`: the stacked
-`TrainState` and metadata identifying the models) and ``metrics.csv`` (one row per logged step and
+`TrainState` and metadata: the models' identity and, under `MODEL_CONFIG_KEY` and `MODEL_VARIANTS_KEY`, their `ModelConfig` and variants, which
+`pushjax.train.predictor.load_model` rebuilds them from) and ``metrics.csv`` (one row per logged step and
 model: step, model, name, loss and the loss's metrics in mm / degrees; `pushjax.train.metrics_log`).
 """
 
@@ -59,6 +60,10 @@ from pushjax.train.train_state import TrainState, create_train_state, make_optim
 
 SWEEP_MODES = ("vmap", "unroll", "sequential")
 """How `sweep` steps its K models (see the module docstring)."""
+MODEL_CONFIG_KEY = "model_config"
+"""The checkpoint metadata's key of the models' `ModelConfig` (as `dataclasses.asdict`)."""
+MODEL_VARIANTS_KEY = "model_variants"
+"""The checkpoint metadata's key of each model's variant (they differ in a sweep that mixes the error variants)."""
 
 
 def _error_options(config: ModelConfig, specs: Sequence[ModelSpec]) -> jax.Array | None:
@@ -240,6 +245,8 @@ def sweep(
         "subset_checksums": [int(np.asarray(spec.train_indices, np.int64).sum()) for spec in specs],
         "variant": model_config.variant,
     }
+    checkpoint_metadata = {"identity": identity, MODEL_CONFIG_KEY: dataclasses.asdict(model_config),
+                           MODEL_VARIANTS_KEY: [spec.variant or model_config.variant for spec in specs]}
     if workdir is not None:
         workdir = Path(workdir)
         workdir.mkdir(parents=True, exist_ok=True)
@@ -306,7 +313,7 @@ def sweep(
             if done % train_config.checkpoint_every == 0 or done == train_config.num_steps:
                 snapshot = stacked(models)
                 if checkpointer is not None:
-                    checkpointer.save(done, snapshot, {"identity": identity})
+                    checkpointer.save(done, snapshot, checkpoint_metadata)
                 if checkpoint_callback is not None:
                     checkpoint_callback(done, snapshot)
             if step_callback is not None:
