@@ -22,8 +22,9 @@ standard errors, `pushjax.paper.statistics`). Besides ``rows``:
   ``<workdir>/invocations.jsonl`` when it starts and brought up to date after every sweep, so a call that was
   stopped counts up to its last finished sweep (``"finished": false``).
 
-Each sweep trains in ``<workdir>/<train_split>/l<l_scale>/<variants>`` (checkpoints, ``metrics.csv`` and
-``curves.csv``), so an interrupted run resumes where it stopped.
+Each sweep trains in ``<workdir>/<train_split>/l<l_scale>/<variants>`` (checkpoints, ``metrics.csv``,
+``curves.csv`` and TensorBoard event files under ``tensorboard/``), so an interrupted run resumes where it stopped;
+``tensorboard --logdir=<workdir>`` shows every model of every sweep.
 """
 
 from __future__ import annotations
@@ -158,7 +159,7 @@ def train_sweep(spec: ExperimentSpec, variants: Sequence[str], train_examples: E
     config = spec.train_config(variants[0])
     learning_curves = curves_lib.LearningCurves(
         Path(workdir) / "curves.csv", PushModel(config.model), specs, train_examples, curve_sets or {},
-        config.curve_examples, config.eval_batch_size)
+        config.curve_examples, config.eval_batch_size, Path(workdir) / train_lib.metrics_log.TENSORBOARD_DIR)
     return train_lib.sweep(config, train_examples, specs, workdir, mode=spec.mode, progress=progress,
                            description=description, checkpoint_callback=learning_curves)
 

@@ -30,8 +30,9 @@ parameters, and a model trained alone draws the same batches as inside a sweep.
 
 Work directory layout: ``checkpoints/<step>/`` (orbax, `pushjax.train.checkpoint`: the stacked
 `TrainState` and metadata: the models' identity and, under `MODEL_CONFIG_KEY` and `MODEL_VARIANTS_KEY`, their `ModelConfig` and variants, which
-`pushjax.train.predictor.load_model` rebuilds them from) and ``metrics.csv`` (one row per logged step and
-model: step, model, name, loss and the loss's metrics in mm / degrees; `pushjax.train.metrics_log`).
+`pushjax.train.predictor.load_model` rebuilds them from) ``metrics.csv`` (one row per logged step and
+model: step, model, name, loss and the loss's metrics in mm / degrees; `pushjax.train.metrics_log`) and
+``tensorboard/<model name>/train`` (the same scalars and steps per second, the training config as hparams).
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import os
+import time
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -55,7 +57,7 @@ from pushjax.train import distributed, mesh as mesh_lib
 from pushjax.train.batching import Examples, ModelSpec, batch_indices, gather, model_fields
 from pushjax.train.checkpoint import Checkpointer
 from pushjax.train.configs import TrainConfig
-from pushjax.train.metrics_log import MetricsLog
+from pushjax.train.metrics_log import TENSORBOARD_DIR, MetricsLog, TensorBoardLog, flat_hparams
 from pushjax.train.train_state import TrainState, create_train_state, make_optimizer, make_train_step
 
 SWEEP_MODES = ("vmap", "unroll", "sequential")
@@ -236,7 +238,7 @@ def sweep(
 
     state = _stack([create_train_state(model, optimizer, example_batch, spec.seed) for spec in specs])
     start = 0
-    checkpointer = log = None
+    checkpointer = log = tensorboard = None
     names = [spec.name for spec in specs]
     identity = {
         "names": names,
@@ -267,6 +269,11 @@ def sweep(
                     stacklevel=2)
         if distributed.is_writer():
             log = MetricsLog(workdir / "metrics.csv", start)
+            tensorboard = TensorBoardLog(workdir / TENSORBOARD_DIR, names, "train", start and start + 1)
+            config_hparams = flat_hparams(train_config)
+            tensorboard.write_hparams(
+                [{**config_hparams, "seed": spec.seed, "train_size": len(spec.train_indices),
+                  "variant": spec.variant or model_config.variant} for spec in specs], ("loss",))
     if mode == "sequential":
         def advance(models, batches):
             outputs = [step_fn(models[k], batches[k], None if options is None else options[k])
@@ -294,31 +301,40 @@ def sweep(
 
         models, stacked, local_specs = state, lambda stacked_state: stacked_state, specs
 
-    if checkpoint_callback is not None and start < train_config.num_steps:
-        checkpoint_callback(start, stacked(models))
     metrics = None
-    with tqdm.tqdm(
-        total=train_config.num_steps, initial=start, disable=not progress or not distributed.is_writer(),
-        desc=description or describe_specs(model_config.variant, specs),
-    ) as bar:
-        for step in range(start, train_config.num_steps):
-            models, metrics = advance(models, [batch_at(spec, step) for spec in local_specs])
-            done = step + 1
-            bar.update(1)
-            if done % train_config.log_every == 0 or done == train_config.num_steps:
-                host_metrics = jax.tree.map(np.asarray, metrics)
-                bar.set_postfix(loss=f"{host_metrics['loss'].mean():.3f}")
-                if log is not None:
-                    log.append(done, names, host_metrics)
-            if done % train_config.checkpoint_every == 0 or done == train_config.num_steps:
-                snapshot = stacked(models)
-                if checkpointer is not None:
-                    checkpointer.save(done, snapshot, checkpoint_metadata)
-                if checkpoint_callback is not None:
-                    checkpoint_callback(done, snapshot)
-            if step_callback is not None:
-                step_callback(done, metrics)
-    if checkpointer is not None:
-        checkpointer.close()
+    try:
+        if checkpoint_callback is not None and start < train_config.num_steps:
+            checkpoint_callback(start, stacked(models))
+        last_log = (start, time.perf_counter())
+        with tqdm.tqdm(
+            total=train_config.num_steps, initial=start, disable=not progress or not distributed.is_writer(),
+            desc=description or describe_specs(model_config.variant, specs),
+        ) as bar:
+            for step in range(start, train_config.num_steps):
+                models, metrics = advance(models, [batch_at(spec, step) for spec in local_specs])
+                done = step + 1
+                bar.update(1)
+                if done % train_config.log_every == 0 or done == train_config.num_steps:
+                    host_metrics = jax.tree.map(np.asarray, metrics)
+                    bar.set_postfix(loss=f"{host_metrics['loss'].mean():.3f}")
+                    if log is not None:
+                        log.append(done, names, host_metrics)
+                        steps_per_second = (done - last_log[0]) / (time.perf_counter() - last_log[1])
+                        tensorboard.append(
+                            done, {**host_metrics, "steps_per_second": np.full(len(specs), steps_per_second)})
+                    last_log = (done, time.perf_counter())
+                if done % train_config.checkpoint_every == 0 or done == train_config.num_steps:
+                    snapshot = stacked(models)
+                    if checkpointer is not None:
+                        checkpointer.save(done, snapshot, checkpoint_metadata)
+                    if checkpoint_callback is not None:
+                        checkpoint_callback(done, snapshot)
+                if step_callback is not None:
+                    step_callback(done, metrics)
+    finally:
+        if checkpointer is not None:
+            checkpointer.close()
+        if tensorboard is not None:
+            tensorboard.close()
     final_metrics = {} if metrics is None else jax.tree.map(np.asarray, metrics)
     return SweepResult(model, list(specs), stacked(models), final_metrics)
