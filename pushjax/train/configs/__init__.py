@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import typing
+from collections.abc import Mapping
 
 from pushjax.data.configs import DatasetConfig
 from pushjax.models import ModelConfig
@@ -66,3 +68,63 @@ def get_config(dataset: DatasetConfig) -> TrainConfig:
     config = importlib.import_module(f"pushjax.train.configs.{dataset.scale}").get_config()
     model = dataclasses.replace(config.model, view=dataset.camera, glimpse_size=dataset.glimpse_size)
     return dataclasses.replace(config, model=model)
+
+
+FIXED_BY_RUN = ("model.variant", "model.view")
+"""Fields a run sets itself (its variants and its dataset's camera), which `override` does not take."""
+
+
+def _field_types(config_type: type, prefix: str = "") -> dict[str, type]:
+    types = {}
+    for name, field_type in typing.get_type_hints(config_type).items():
+        if dataclasses.is_dataclass(field_type):
+            types.update(_field_types(field_type, f"{prefix}{name}."))
+        elif f"{prefix}{name}" not in FIXED_BY_RUN:
+            types[f"{prefix}{name}"] = field_type
+    return types
+
+
+OVERRIDABLE_FIELDS: dict[str, type] = _field_types(TrainConfig)
+"""Dotted field path (``learning_rate``, ``model.head_features``) -> its type: what `override` takes."""
+
+
+def _parse(path: str, field_type: type, text: str) -> object:
+    """`text` as a value of `field_type` (int, float, str or a tuple of ints); ValueError naming `path`."""
+    try:
+        if typing.get_origin(field_type) is tuple:
+            return tuple(int(item) for item in text.split(",") if item.strip())
+        return field_type(text)
+    except ValueError:
+        expected = {int: "an integer", float: "a number"}.get(field_type, "comma-separated integers")
+        raise ValueError(f"config.{path}: expected {expected}, got {text!r}") from None
+
+
+def override(config: TrainConfig, overrides: Mapping[str, str]) -> TrainConfig:
+    """`config` with fields replaced from the command line (``--config.<path>=<text>``).
+
+    Args:
+      config: the scale's config.
+      overrides: dotted field path (a key of `OVERRIDABLE_FIELDS`) -> its new value as text (tuples of ints comma
+        separated, e.g. ``"64,32"``).
+
+    Raises:
+      ValueError: one line naming ``config.<path>``: a field that does not exist, a value of the wrong type or one
+        the config rejects.
+    """
+    values = {}
+    for path, text in overrides.items():
+        if path not in OVERRIDABLE_FIELDS:
+            fixed = " (set by the run itself)" if path in FIXED_BY_RUN else ""
+            raise ValueError(f"config.{path}: no such training-config field{fixed}; "
+                             f"expected one of {', '.join(OVERRIDABLE_FIELDS)}")
+        values[path] = _parse(path, OVERRIDABLE_FIELDS[path], text)
+    model_values = {path.removeprefix("model."): value for path, value in values.items() if path.startswith("model.")}
+    try:
+        model = dataclasses.replace(config.model, **model_values)
+    except ValueError as error:
+        raise ValueError(f"config.model.{error}") from None
+    try:
+        return dataclasses.replace(config, model=model, **{path: value for path, value in values.items()
+                                                           if not path.startswith("model.")})
+    except ValueError as error:
+        raise ValueError(f"config.{error}") from None
