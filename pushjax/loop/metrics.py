@@ -12,6 +12,7 @@ import numpy as np
 from scipy import stats
 
 from pushjax import planar
+from pushjax.stats import resample_sequences
 
 METRIC_KEYS = ("trans_pct", "rot_pct", "trans_mm", "rot_deg")
 EXACT_FLIPS_UP_TO = 13
@@ -77,8 +78,7 @@ def _resampling_counts(sequence: np.ndarray, n_bootstrap: int, seed: int):
     def per_sequence(values):
         return np.bincount(index, weights=values, minlength=len(ids))
 
-    counts = np.random.default_rng(seed).multinomial(len(ids), np.full(len(ids), 1 / len(ids)), size=n_bootstrap)
-    return counts, per_sequence
+    return resample_sequences(len(ids), n_bootstrap, seed), per_sequence
 
 
 def bootstrap_combined(errors: list[WindowErrors], n_bootstrap: int = 1000, seed: int = 0) -> np.ndarray:

@@ -7,15 +7,12 @@ import json
 import math
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from pushjax.loop import diagnose as diagnose_lib  # noqa: E402
-from pushjax.loop.metrics import METRIC_KEYS  # noqa: E402
-from pushjax.loop.windows import CATEGORICAL, VARIABLES, Examples  # noqa: E402
+from pushjax.loop import diagnose as diagnose_lib
+from pushjax.loop.metrics import METRIC_KEYS
+from pushjax.loop.windows import CATEGORICAL, VARIABLES, Examples
 
 FIGURE_DIR = "figures"
 
