@@ -32,7 +32,7 @@ import numpy as np
 
 from pushjax import train as train_lib
 from pushjax.models import ModelConfig
-from pushjax.paper import runner, spec as spec_lib
+from pushjax.paper import paths, runner, spec as spec_lib
 from pushjax.train import convergence, evaluate
 
 NAME = "data_efficiency_full"
@@ -148,7 +148,7 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Mappin
         "parameters": int(sum(np.size(leaf) for leaf in jax.tree.leaves(trained.state.params))),
         "train_seconds": round(trained.seconds, 1), "eval_seconds": round(time.monotonic() - clock, 1),
         "steps_per_second": trained.steps_per_second, "started": started.isoformat(timespec="seconds"),
-        "commit": runner._git_commit(),
+        **({"commit": commit} if (commit := paths.git_commit()) else {}),
     })
 
 
@@ -176,7 +176,8 @@ def assemble(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence
     return {"name": NAME, "config": config, "rows": rows, "curves": curves,
             "progress": {"planned": len(units), "done": sum(unit.key in done for unit in units),
                          "missing": [unit.key for unit in units if unit.key not in done]},
-            "provenance": {"commit": runner._git_commit(), "model_seconds": round(train_seconds, 1)}}
+            "provenance": {**({"commit": commit} if (commit := paths.git_commit()) else {}),
+                           "model_seconds": round(train_seconds, 1)}}
 
 
 def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit], *,
