@@ -45,8 +45,8 @@ class Checkpointer:
         self._manager = ocp.CheckpointManager(
             os.path.abspath(directory),
             options=ocp.CheckpointManagerOptions(
-                max_to_keep=max_to_keep, enable_async_checkpointing=False, create=not read_only,
-                read_only=read_only,
+                max_to_keep=None if read_only else max_to_keep, enable_async_checkpointing=False,
+                create=not read_only, read_only=read_only, save_interval_steps=0 if read_only else 1,
             ),
             item_names=("state", "metadata"),
         )

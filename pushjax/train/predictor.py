@@ -177,7 +177,8 @@ def load_model(path: str | os.PathLike, model: int | str = 0, step: int | None =
     Args:
       path: a sweep's work directory, its ``checkpoints`` folder, or a run's work directory holding one sweep
         (`pushjax.paper.runner`; with several, the error lists them).
-      model: which of the sweep's models: its index, or its name (e.g. ``"size=200/seed=0"``).
+      model: which of the sweep's models: its index (negative from the end: -1 is the largest size's last seed), or
+        its name (e.g. ``"size=200/seed=0"``).
       step: the checkpoint's step; None: the newest.
 
     Raises:
@@ -203,8 +204,9 @@ def load_model(path: str | os.PathLike, model: int | str = 0, step: int | None =
                          "it, or resume its sweep for a step, to load it")
     names = metadata["identity"]["names"]
     index = names.index(model) if model in names else model
-    if not isinstance(index, int) or not 0 <= index < len(names):
-        raise ValueError(f"model: expected an index in [0, {len(names)}) or one of {names}, got {model!r}")
+    if not isinstance(index, int) or not -len(names) <= index < len(names):
+        raise ValueError(f"model: expected an index in [{-len(names)}, {len(names)}) or one of {names}, got {model!r}")
+    index %= len(names)
     config = model_config_from_json(metadata[MODEL_CONFIG_KEY])
     if config.variant == "neural_dyn":
         raise ValueError("model: neural_dyn predicts from the true contact state, not from images; load another variant")

@@ -52,9 +52,9 @@ def test_loaded_model_predicts_as_the_trained_one(trained, examples):
 def test_load_model_reads_without_writing_and_names_what_is_wrong(trained, tmp_path):
     run, _ = trained
     before = sorted((path, path.stat().st_mtime_ns) for path in run.rglob("*"))
-    load_model(run / "train" / "l1" / "hybrid" / "checkpoints", model=0)
+    assert load_model(run / "train" / "l1" / "hybrid" / "checkpoints", model=-1).name == "size=20/seed=1"
     assert sorted((path, path.stat().st_mtime_ns) for path in run.rglob("*")) == before
-    with pytest.raises(ValueError, match=r"model: expected an index in \[0, 2\) or one of"):
+    with pytest.raises(ValueError, match=r"model: expected an index in \[-2, 2\) or one of"):
         load_model(run, model="size=99/seed=0")
     with pytest.raises(ValueError, match="step: .* steps \\[2\\], not 7"):
         load_model(run, step=7)
