@@ -131,6 +131,80 @@ def _compiled_step(
     return jax.jit(unrolled_step if mesh is None else mesh_lib.map_models(unrolled_step, mesh))
 
 
+class _SequentialStepper:
+    """``sequential``: the jitted single-model step once per model, the K states kept apart."""
+
+    def __init__(self, step_fn: Callable, state: TrainState, specs: Sequence[ModelSpec], options: jax.Array | None):
+        self._step_fn, self._options, self.local_specs = step_fn, options, list(specs)
+        self._models = _unstack(state, len(specs))
+
+    def advance(self, batches: Sequence[Mapping[str, np.ndarray]]) -> dict[str, jax.Array]:
+        """One step of every model on its batch; the [K] metrics."""
+        outputs = [self._step_fn(model, batch, None if self._options is None else self._options[k])
+                   for k, (model, batch) in enumerate(zip(self._models, batches))]
+        self._models = [model for model, _ in outputs]
+        return _stack([metrics for _, metrics in outputs])
+
+    def state(self) -> TrainState:
+        """The K models' stacked state."""
+        return _stack(self._models)
+
+
+class _StackedStepper:
+    """``vmap`` / ``unroll`` on one device: one jitted step of the stacked state."""
+
+    def __init__(self, step_fn: Callable, state: TrainState, specs: Sequence[ModelSpec], options: jax.Array | None,
+                 fields: Sequence[str]):
+        self._step_fn, self._options, self._fields, self.local_specs = step_fn, options, fields, list(specs)
+        self._state = state
+
+    def advance(self, batches: Sequence[Mapping[str, np.ndarray]]) -> dict[str, jax.Array]:
+        batch = {name: np.stack([b[name] for b in batches]) for name in self._fields}
+        self._state, metrics = self._step_fn(self._state, batch, self._options)
+        return metrics
+
+    def state(self) -> TrainState:
+        return self._state
+
+
+class _ShardedStepper:
+    """``vmap`` / ``unroll`` over a device mesh: the model axis padded to a multiple of the devices and sharded;
+    this process steps its own rows (`mesh_lib.local_rows`), a padding row repeating the last model."""
+
+    def __init__(self, step_fn: Callable, state: TrainState, specs: Sequence[ModelSpec], options: jax.Array | None,
+                 fields: Sequence[str], mesh: Mesh):
+        self._step_fn, self._fields, self._mesh, self._count = step_fn, fields, mesh, len(specs)
+        self._padded = mesh_lib.padded_count(len(specs), mesh)
+        self._options = None if options is None else mesh_lib.shard(mesh_lib.pad(options, self._padded),
+                                                                    self._padded, mesh)
+        self._state = mesh_lib.shard(mesh_lib.pad(state, self._padded), self._padded, mesh)
+        self.local_specs = [specs[min(row, len(specs) - 1)] for row in mesh_lib.local_rows(self._padded, mesh)]
+
+    def advance(self, batches: Sequence[Mapping[str, np.ndarray]]) -> dict[str, jax.Array]:
+        batch = {name: np.stack([b[name] for b in batches]) for name in self._fields}
+        self._state, metrics = self._step_fn(self._state, mesh_lib.shard(batch, self._padded, self._mesh),
+                                             self._options)
+        return mesh_lib.unshard(metrics, self._count, self._mesh)
+
+    def state(self) -> TrainState:
+        return mesh_lib.unshard(self._state, self._count, self._mesh)
+
+
+def _make_stepper(mode: str, step_fn: Callable, state: TrainState, specs: Sequence[ModelSpec],
+                  options: jax.Array | None, fields: Sequence[str], mesh: Mesh | None):
+    """The stepper of `mode` (one of `SWEEP_MODES`) starting from the K models' stacked `state`.
+
+    Each has ``local_specs`` (the models whose batches this process draws, in row order), ``advance(batches)`` (one
+    step; returns the K models' {name: [K]} metrics) and ``state()`` (the K models' stacked `TrainState`, on one
+    device).
+    """
+    if mode == "sequential":
+        return _SequentialStepper(step_fn, state, specs, options)
+    if mesh is not None:
+        return _ShardedStepper(step_fn, state, specs, options, fields, mesh)
+    return _StackedStepper(step_fn, state, specs, options, fields)
+
+
 @dataclasses.dataclass(frozen=True)
 class SweepResult:
     """Outcome of `sweep`.
@@ -274,44 +348,18 @@ def sweep(
             tensorboard.write_hparams(
                 [{**config_hparams, "seed": spec.seed, "train_size": len(spec.train_indices),
                   "variant": spec.variant or model_config.variant} for spec in specs], ("loss",))
-    if mode == "sequential":
-        def advance(models, batches):
-            outputs = [step_fn(models[k], batches[k], None if options is None else options[k])
-                       for k in range(len(specs))]
-            return [model_state for model_state, _ in outputs], _stack([metrics for _, metrics in outputs])
-
-        models, stacked, local_specs = _unstack(state, len(specs)), _stack, specs
-    elif mesh is not None:
-        padded = mesh_lib.padded_count(len(specs), mesh)
-        if options is not None:
-            options = mesh_lib.shard(mesh_lib.pad(options, padded), padded, mesh)
-
-        def advance(models, batches):
-            batch = {name: np.stack([b[name] for b in batches]) for name in fields}
-            models, metrics = step_fn(models, mesh_lib.shard(batch, padded, mesh), options)
-            return models, mesh_lib.unshard(metrics, len(specs), mesh)
-
-        models = mesh_lib.shard(mesh_lib.pad(state, padded), padded, mesh)
-        stacked = functools.partial(mesh_lib.unshard, count=len(specs), mesh=mesh)
-        # This process's rows of the padded model axis; a padding row repeats the last model.
-        local_specs = [specs[min(row, len(specs) - 1)] for row in mesh_lib.local_rows(padded, mesh)]
-    else:
-        def advance(models, batches):
-            return step_fn(models, {name: np.stack([b[name] for b in batches]) for name in fields}, options)
-
-        models, stacked, local_specs = state, lambda stacked_state: stacked_state, specs
-
+    stepper = _make_stepper(mode, step_fn, state, specs, options, fields, mesh)
     metrics = None
     try:
         if checkpoint_callback is not None and start < train_config.num_steps:
-            checkpoint_callback(start, stacked(models))
+            checkpoint_callback(start, stepper.state())
         last_log = (start, time.perf_counter())
         with tqdm.tqdm(
             total=train_config.num_steps, initial=start, disable=not progress or not distributed.is_writer(),
             desc=description or describe_specs(model_config.variant, specs),
         ) as bar:
             for step in range(start, train_config.num_steps):
-                models, metrics = advance(models, [batch_at(spec, step) for spec in local_specs])
+                metrics = stepper.advance([batch_at(spec, step) for spec in stepper.local_specs])
                 done = step + 1
                 bar.update(1)
                 if done % train_config.log_every == 0 or done == train_config.num_steps:
@@ -324,7 +372,7 @@ def sweep(
                             done, {**host_metrics, "steps_per_second": np.full(len(specs), steps_per_second)})
                     last_log = (done, time.perf_counter())
                 if done % train_config.checkpoint_every == 0 or done == train_config.num_steps:
-                    snapshot = stacked(models)
+                    snapshot = stepper.state()
                     if checkpointer is not None:
                         checkpointer.save(done, snapshot, checkpoint_metadata)
                     if checkpoint_callback is not None:
@@ -337,4 +385,4 @@ def sweep(
         if tensorboard is not None:
             tensorboard.close()
     final_metrics = {} if metrics is None else jax.tree.map(np.asarray, metrics)
-    return SweepResult(model, list(specs), stacked(models), final_metrics)
+    return SweepResult(model, list(specs), stepper.state(), final_metrics)
