@@ -8,6 +8,7 @@ import pytest
 from tensorboardX.proto import event_pb2, plugin_hparams_pb2
 
 from pushjax import train
+from pushjax.train import convergence, metrics_log
 from tests.tiny_configs import TINY_SMOKE
 
 CONFIG = dataclasses.replace(TINY_SMOKE, num_steps=6, log_every=1, checkpoint_every=3)
@@ -86,3 +87,18 @@ def test_a_killed_and_resumed_sweep_shows_the_uninterrupted_scalars(uninterrupte
                           if item[0][0] != "steps_per_second")
         assert [key for key, _ in resumed] == [key for key, _ in expected]  # steps 4 and 5 once, though logged twice
         np.testing.assert_allclose([value for _, value in resumed], [value for _, value in expected], rtol=1e-6)
+
+
+def test_a_model_trained_to_convergence_logs_its_validation_scores(examples, tmp_path):
+    spec, = train.subset_specs(len(examples["motion"]), [20], [0])
+    criterion = convergence.Criterion(eval_every=2, window=2, base_steps=4, steps_per_example=0, max_steps=4,
+                                      min_decay_steps=1)
+    log = metrics_log.TensorBoardLog(tmp_path, [spec.name], "train", first_step=0)
+    trained = convergence.train_until_converged(CONFIG, examples, spec, examples, criterion, tensorboard=log)
+    log.close()
+    scalars = _scalars(tmp_path / spec.name / "train")
+    assert [step for step, _, _ in trained.history] == sorted(
+        step for tag, step in scalars if tag == "validation/score")
+    for step, trans, rot in trained.history:
+        assert scalars[("validation/trans_percent", step)] == pytest.approx(trans, rel=1e-6)
+        assert scalars[("validation/rot_percent", step)] == pytest.approx(rot, rel=1e-6)
