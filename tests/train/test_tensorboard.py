@@ -97,8 +97,8 @@ def test_a_model_trained_to_convergence_logs_its_validation_scores(examples, tmp
     trained = convergence.train_until_converged(CONFIG, examples, spec, examples, criterion, tensorboard=log)
     log.close()
     scalars = _scalars(tmp_path / spec.name / "train")
-    assert [step for step, _, _ in trained.history] == sorted(
+    assert [step for step, _, _ in trained.validation] == sorted(
         step for tag, step in scalars if tag == "validation/score")
-    for step, trans, rot in trained.history:
+    for step, trans, rot in trained.validation:
         assert scalars[("validation/trans_percent", step)] == pytest.approx(trans, rel=1e-6)
         assert scalars[("validation/rot_percent", step)] == pytest.approx(rot, rel=1e-6)
