@@ -27,7 +27,7 @@ for name in clean com_offset pressure anisotropy table_tilt pusher_friction trac
   "$python" - "$work/out/$name/report.json" "$name" <<'PY'
 import json, sys
 report = json.load(open(sys.argv[1]))
-total = lambda errors: errors["trans_pct"] + errors["rot_pct"]
+total = lambda errors: errors["trans_percent"] + errors["rot_percent"]
 print(f"| {sys.argv[2]} | {total(report['baseline']):.1f} | {total(report['after']):.1f} | "
       f"{1 - total(report['after']) / total(report['baseline']):.0%} | "
       f"{', '.join(report['selected']) or '-'} | {total(report['noise_floor']):.1f} | {report['explained']} | "

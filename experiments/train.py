@@ -2,7 +2,8 @@ r"""Train one model variant of Kloss et al. on a push dataset and evaluate it on
 
   python -m experiments.train --variant=hybrid --experiment=data_efficiency --scale=smoke --workdir=DIR \
       [--sizes=100,500] [--seeds=0,1,2] [--mix_error_variants] [--num_steps=N] [--data_dir=DIR] \
-      [--train_split=train] [--test_split=test] [--nobuild] [--mode=vmap|unroll|sequential]
+      [--train_split=train] [--test_split=test] [--nobuild] [--mode=vmap|unroll|sequential] \
+      [--config.learning_rate=3e-4 --config.model.head_features=64,32 ...]
 
 One sweep trains a model per (training-set size, seed), each on its own random subset of the training split.
 Without ``--sizes`` every model sees the whole split. ``--mix_error_variants`` (with an error variant) trains
@@ -10,8 +11,10 @@ error, error_grad and error_norm side by side for every subset. The view follows
 (``viewpoint``: free camera, point clouds; otherwise top-down depth), the glimpse size the dataset config.
 
 The run goes through the same orchestrator as the experiment binaries (`pushjax.paper.runner.run`): the work
-directory gets ``<train_split>/l1/<variants>/`` (checkpoints, so an interrupted run resumes, and ``metrics.csv``)
-and ``results.json`` in the schema documented there.
+directory gets ``<train_split>/l1/<variants>/`` (checkpoints with the model configuration, so an interrupted run
+resumes and `pushjax.train.predictor.load_model` loads a model; ``metrics.csv``, ``curves.csv`` and TensorBoard event
+files under ``tensorboard/``) and ``results.json`` in the schema documented there. ``--config.<field>`` replaces any
+field of the training config (`pushjax.paper.cli`), recorded in ``results.json``'s ``config``.
 """
 
 from __future__ import annotations

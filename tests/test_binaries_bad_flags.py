@@ -126,6 +126,8 @@ CASES = [
     ("data_efficiency", [*RUN, "--num_processes=2", "--coordinator_address=localhost"], "--coordinator_address"),
     ("data_efficiency", [*RUN, "--coordinator_address=127.0.0.1:1234"], "--coordinator_address"),
     ("data_efficiency", [*RUN, "extra"], "unexpected arguments"),
+    ("data_efficiency", [*RUN, "--config.schedule=bogus"], "--config.schedule"),
+    ("data_efficiency", [*RUN, "--config.bogus=1"], "config.bogus"),
     # Each other experiment binary: the shared flags are wired, and its datasets are looked for.
     *[(binary, [*RUN], "--build") for binary in EXPERIMENTS[1:]],
     *[(binary, [*RUN, "--workdir={file}/work"], "--workdir") for binary in EXPERIMENTS[1:]],
@@ -141,6 +143,8 @@ CASES = [
     ("train", [*RUN, "--workdir={file}/work"], "--workdir"),
     ("train", [*RUN, "--seeds=1.5"], "--seeds"),
     ("train", [*RUN, "extra"], "unexpected arguments"),
+    ("train", [*RUN, "--config.batch_size=x"], "--config.batch_size"),
+    ("train", [*RUN, "--config.model.head_features=a,b"], "--config.model.head_features"),
     # build_dataset
     ("build_dataset", ["--data_dir={tmp}/data", "--experiment=bogus"], "--experiment"),
     ("build_dataset", ["--data_dir={tmp}/data", "--scale=huge"], "--scale"),

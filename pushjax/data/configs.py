@@ -67,7 +67,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import zlib
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -288,6 +288,105 @@ def contact_point_id(params: PushParams) -> int:
     return params.side * len(points) + int(np.argmin(np.abs(points - params.point)))
 
 
+Jobs = dict[str, list[PushJob]]
+"""Split name -> the recording jobs of its sequences."""
+
+
+def _held_out_pushes(config: DatasetConfig, raw_dir: Path) -> Jobs:
+    """``data_efficiency``, ``viewpoint``: every object's pushes at 20 mm/s split at random into train, validation
+    and test."""
+    jobs: Jobs = {"train": [], "validation": [], "test": []}
+    for obj in OBJECT_NAMES:
+        # The MIT grid of a triangle has 297 distinct pushes per velocity: at paper scale that leaves 7 for validation.
+        validations = min(config.test_pushes_per_object, _distinct_pushes(obj) - config.pushes_per_object)
+        pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object + validations, config, raw_dir)
+        rng = np.random.default_rng(_key(config.seed, obj, config.experiment, "split"))
+        pool, validation = _split_off(pool, validations / len(pool), rng)
+        train, test = _split_off(pool, config.test_fraction, rng)
+        for name, split_jobs in (("train", train), ("validation", validation), ("test", test)):
+            jobs[name] += split_jobs
+    return jobs
+
+
+def _new_pushes(config: DatasetConfig, raw_dir: Path) -> Jobs:
+    """``new_pushes``: pushes at held-out angles or contact points are the test split."""
+    jobs: Jobs = {"train": [], "validation": [], "test": []}
+    held_angles = np.radians(NEW_PUSH_TEST_ANGLES_DEG)
+    for obj in OBJECT_NAMES:
+        pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object, config, raw_dir)
+        rng = np.random.default_rng(_key(config.seed, obj, config.experiment, "split"))
+        held_points = held_out_contact_points(obj, config)
+        is_test = [bool(np.any(np.abs(held_angles - job.params.angle) < 1e-3))
+                   or contact_point_id(job.params) in held_points for job in pool]
+        jobs["test"] += [job for job, test in zip(pool, is_test) if test]
+        train, validation = _split_off([job for job, test in zip(pool, is_test) if not test],
+                                       config.validation_fraction, rng)
+        jobs["train"] += train
+        jobs["validation"] += validation
+    return jobs
+
+
+def _velocities(config: DatasetConfig, raw_dir: Path) -> Jobs:
+    """``velocities``: a test split per velocity, training sets mixing the trained velocities in equal shares."""
+    jobs: Jobs = {}
+    train_pools: dict[float, dict[str, list]] = {}
+    for velocity in TEST_VELOCITIES:
+        trained = any(velocity in velocities for velocities in VELOCITY_TRAIN_SETS.values())
+        jobs[f"test_{velocity:g}"] = []
+        for obj in OBJECT_NAMES:
+            if trained:
+                pool = _pool(obj, velocity, config.pushes_per_object, config, raw_dir)
+                rng = np.random.default_rng(_key(config.seed, obj, velocity, "split"))
+                train, test = _split_off(pool, config.test_fraction, rng)
+                train_pools.setdefault(velocity, {})[obj] = train
+            else:
+                test = _pool(obj, velocity, config.test_pushes_per_object, config, raw_dir)
+            jobs[f"test_{velocity:g}"] += test
+    for name, velocities in VELOCITY_TRAIN_SETS.items():
+        jobs[name] = [job for obj in OBJECT_NAMES for job in _equal_shares(
+            [train_pools[v][obj] for v in velocities], len(train_pools[TRAIN_VELOCITY][obj]))]
+    return jobs
+
+
+def _objects(config: DatasetConfig, raw_dir: Path) -> Jobs:
+    """``objects``: training sets of object groups in equal shares, test sets of seen and unseen objects."""
+    jobs: Jobs = {}
+    trained = sorted({obj for objects in OBJECT_TRAIN_SETS.values() for obj in objects})
+    train_pools = {}
+    for name, objects in OBJECT_TEST_SETS.items():
+        jobs[name] = []
+        for obj in objects:
+            if obj in trained:
+                pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object + config.test_pushes_per_object,
+                             config, raw_dir)
+                rng = np.random.default_rng(_key(config.seed, obj, config.experiment, "split"))
+                train_pools[obj], test = _split_off(pool, config.test_pushes_per_object / len(pool), rng)
+            else:
+                test = _pool(obj, TRAIN_VELOCITY, config.test_pushes_per_object, config, raw_dir)
+            jobs[name] += test
+    for obj in trained:
+        if obj not in train_pools:
+            train_pools[obj] = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object, config, raw_dir)
+    size = len(train_pools["butter"])
+    for name, objects in OBJECT_TRAIN_SETS.items():
+        jobs[name] = _equal_shares([train_pools[obj] for obj in objects], size)
+    return {name: jobs[name] for name in (*OBJECT_TRAIN_SETS, *OBJECT_TEST_SETS)}
+
+
+def _repeated(config: DatasetConfig, raw_dir: Path) -> Jobs:
+    """``repeated``: the one repeated push as the test split."""
+    return {"test": [PushJob(path=raw_path(raw_dir, REPEATED_PUSH), params=REPEATED_PUSH, effects=Effects(),
+                             support="grid", noise_seed=(config.seed,), attributes=None,
+                             testbed=config.testbed_profile)]}
+
+
+SPLIT_PLANS: dict[str, Callable[[DatasetConfig, Path], Jobs]] = {
+    "data_efficiency": _held_out_pushes, "viewpoint": _held_out_pushes, "new_pushes": _new_pushes,
+    "velocities": _velocities, "objects": _objects, "repeated": _repeated,
+}
+"""Experiment -> how its sequences are planned and split (one entry per name of `EXPERIMENTS`)."""
+
+
 def plan_splits(config: DatasetConfig, raw_dir: str | Path) -> SplitPlan:
     """The sequences of ``config``'s dataset and their assignment to splits; deterministic for the config.
 
@@ -295,77 +394,7 @@ def plan_splits(config: DatasetConfig, raw_dir: str | Path) -> SplitPlan:
       config: the dataset.
       raw_dir: root of the raw (MIT layout) cache of the simulated sequences (of ``config.testbed``).
     """
-    raw_dir = Path(raw_dir)
-    per_split: dict[str, list[PushJob]] = {}  # split name -> recording jobs
-    experiment = config.experiment
-    if experiment in ("data_efficiency", "viewpoint"):
-        per_split = {"train": [], "validation": [], "test": []}
-        for obj in OBJECT_NAMES:
-            # The MIT grid of a triangle has 297 distinct pushes per velocity: at paper scale that leaves 7 for validation.
-            validations = min(config.test_pushes_per_object, _distinct_pushes(obj) - config.pushes_per_object)
-            pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object + validations, config, raw_dir)
-            rng = np.random.default_rng(_key(config.seed, obj, experiment, "split"))
-            pool, validation = _split_off(pool, validations / len(pool), rng)
-            train, test = _split_off(pool, config.test_fraction, rng)
-            for name, jobs in (("train", train), ("validation", validation), ("test", test)):
-                per_split[name] += jobs
-    elif experiment == "new_pushes":
-        per_split = {"train": [], "validation": [], "test": []}
-        held_angles = np.radians(NEW_PUSH_TEST_ANGLES_DEG)
-        for obj in OBJECT_NAMES:
-            pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object, config, raw_dir)
-            rng = np.random.default_rng(_key(config.seed, obj, experiment, "split"))
-            held_points = held_out_contact_points(obj, config)
-            is_test = [bool(np.any(np.abs(held_angles - job.params.angle) < 1e-3))
-                       or contact_point_id(job.params) in held_points for job in pool]
-            per_split["test"] += [job for job, test in zip(pool, is_test) if test]
-            train, validation = _split_off([job for job, test in zip(pool, is_test) if not test],
-                                           config.validation_fraction, rng)
-            per_split["train"] += train
-            per_split["validation"] += validation
-    elif experiment == "velocities":
-        train_pools: dict[float, dict[str, list]] = {}
-        for velocity in TEST_VELOCITIES:
-            trained = any(velocity in velocities for velocities in VELOCITY_TRAIN_SETS.values())
-            per_split[f"test_{velocity:g}"] = []
-            for obj in OBJECT_NAMES:
-                if trained:
-                    pool = _pool(obj, velocity, config.pushes_per_object, config, raw_dir)
-                    rng = np.random.default_rng(_key(config.seed, obj, velocity, "split"))
-                    train, test = _split_off(pool, config.test_fraction, rng)
-                    train_pools.setdefault(velocity, {})[obj] = train
-                else:
-                    test = _pool(obj, velocity, config.test_pushes_per_object, config, raw_dir)
-                per_split[f"test_{velocity:g}"] += test
-        for name, velocities in VELOCITY_TRAIN_SETS.items():
-            per_split[name] = [job for obj in OBJECT_NAMES for job in _equal_shares(
-                [train_pools[v][obj] for v in velocities], len(train_pools[TRAIN_VELOCITY][obj]))]
-    elif experiment == "objects":
-        trained = sorted({obj for objects in OBJECT_TRAIN_SETS.values() for obj in objects})
-        train_pools = {}
-        for name, objects in OBJECT_TEST_SETS.items():
-            per_split[name] = []
-            for obj in objects:
-                if obj in trained:
-                    pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object + config.test_pushes_per_object,
-                                 config, raw_dir)
-                    rng = np.random.default_rng(_key(config.seed, obj, experiment, "split"))
-                    train_pools[obj], test = _split_off(pool, config.test_pushes_per_object / len(pool), rng)
-                else:
-                    test = _pool(obj, TRAIN_VELOCITY, config.test_pushes_per_object, config, raw_dir)
-                per_split[name] += test
-        for obj in trained:
-            if obj not in train_pools:
-                train_pools[obj] = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object, config, raw_dir)
-        size = len(train_pools["butter"])
-        for name, objects in OBJECT_TRAIN_SETS.items():
-            per_split[name] = _equal_shares([train_pools[obj] for obj in objects], size)
-        per_split = {name: per_split[name] for name in (*OBJECT_TRAIN_SETS, *OBJECT_TEST_SETS)}
-    elif experiment == "repeated":
-        per_split = {"test": [PushJob(path=raw_path(raw_dir, REPEATED_PUSH), params=REPEATED_PUSH,
-                                      effects=Effects(), support="grid", noise_seed=(config.seed,),
-                                      attributes=None, testbed=config.testbed_profile)]}
-
+    per_split = SPLIT_PLANS[config.experiment](config, Path(raw_dir))
     by_path = {job.path: job for jobs in per_split.values() for job in jobs}
     paths = sorted(by_path)
     ids = {path: index for index, path in enumerate(paths)}

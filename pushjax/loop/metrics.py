@@ -12,8 +12,9 @@ import numpy as np
 from scipy import stats
 
 from pushjax import planar
+from pushjax.stats import resample_sequences
 
-METRIC_KEYS = ("trans_pct", "rot_pct", "trans_mm", "rot_deg")
+METRIC_KEYS = ("trans_percent", "rot_percent", "trans_mm", "rot_deg")
 EXACT_FLIPS_UP_TO = 13
 """Sign-flip tests over at most this many sequences enumerate every sign pattern (2^13 = 8192)."""
 
@@ -56,10 +57,10 @@ def concatenate(parts: list[WindowErrors]) -> WindowErrors:
 
 
 def summarize(errors: WindowErrors) -> dict[str, float]:
-    """{trans_pct, rot_pct, trans_mm, rot_deg}: mean errors, and their ratio to the zero baseline's in %."""
+    """{trans_percent, rot_percent, trans_mm, rot_deg}: mean errors, and their ratio to the zero baseline's in %."""
     return {
-        "trans_pct": float(100 * errors.translation_mm.sum() / max(errors.zero_translation_mm.sum(), 1e-12)),
-        "rot_pct": float(100 * errors.rotation_deg.sum() / max(errors.zero_rotation_deg.sum(), 1e-12)),
+        "trans_percent": float(100 * errors.translation_mm.sum() / max(errors.zero_translation_mm.sum(), 1e-12)),
+        "rot_percent": float(100 * errors.rotation_deg.sum() / max(errors.zero_rotation_deg.sum(), 1e-12)),
         "trans_mm": float(errors.translation_mm.mean()),
         "rot_deg": float(errors.rotation_deg.mean()),
     }
@@ -67,7 +68,7 @@ def summarize(errors: WindowErrors) -> dict[str, float]:
 
 def combined(summary: dict[str, float]) -> float:
     """The selection score: translation + rotation error, each in % of the zero baseline."""
-    return summary["trans_pct"] + summary["rot_pct"]
+    return summary["trans_percent"] + summary["rot_percent"]
 
 
 def _resampling_counts(sequence: np.ndarray, n_bootstrap: int, seed: int):
@@ -77,8 +78,7 @@ def _resampling_counts(sequence: np.ndarray, n_bootstrap: int, seed: int):
     def per_sequence(values):
         return np.bincount(index, weights=values, minlength=len(ids))
 
-    counts = np.random.default_rng(seed).multinomial(len(ids), np.full(len(ids), 1 / len(ids)), size=n_bootstrap)
-    return counts, per_sequence
+    return resample_sequences(len(ids), n_bootstrap, seed), per_sequence
 
 
 def bootstrap_combined(errors: list[WindowErrors], n_bootstrap: int = 1000, seed: int = 0) -> np.ndarray:
@@ -102,9 +102,9 @@ def bootstrap_interval(errors: WindowErrors, n_bootstrap: int = 1000, seed: int 
     counts, per_sequence = _resampling_counts(errors.sequence, n_bootstrap, seed)
     windows = counts @ per_sequence(np.ones(len(errors.sequence)))
     resampled = {
-        "trans_pct": 100 * (counts @ per_sequence(errors.translation_mm))
+        "trans_percent": 100 * (counts @ per_sequence(errors.translation_mm))
         / np.maximum(counts @ per_sequence(errors.zero_translation_mm), 1e-12),
-        "rot_pct": 100 * (counts @ per_sequence(errors.rotation_deg))
+        "rot_percent": 100 * (counts @ per_sequence(errors.rotation_deg))
         / np.maximum(counts @ per_sequence(errors.zero_rotation_deg), 1e-12),
         "trans_mm": (counts @ per_sequence(errors.translation_mm)) / windows,
         "rot_deg": (counts @ per_sequence(errors.rotation_deg)) / windows,
@@ -176,23 +176,23 @@ class NoiseFloor:
     """The error the best possible model would still have on a set of windows.
 
     Attributes:
-      trans_pct, rot_pct: translation and rotation error in % of the ``zero`` baseline's on the same windows.
-      interval: {"trans_pct", "rot_pct": [low, high]} 95 % sequence-bootstrap interval.
+      trans_percent, rot_percent: translation and rotation error in % of the ``zero`` baseline's on the same windows.
+      interval: {"trans_percent", "rot_percent": [low, high]} 95 % sequence-bootstrap interval.
       source: ``"repeats"`` (the spread of repeated pushes: tracking noise and everything that differs between
         repetitions) or ``"tracking"`` (only the measurement noise seen in the pose streams, a lower bound, where no
         push is repeated).
       n_windows: windows it is estimated on.
     """
 
-    trans_pct: float
-    rot_pct: float
+    trans_percent: float
+    rot_percent: float
     interval: dict[str, list[float]]
     source: str
     n_windows: int
 
     @property
     def score(self) -> float:
-        return self.trans_pct + self.rot_pct
+        return self.trans_percent + self.rot_percent
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -240,8 +240,8 @@ def noise_floor(target: np.ndarray, sequence: np.ndarray, push: np.ndarray, wind
                           zero_rotation_deg=np.degrees(np.abs(target[keep, 2])), sequence=np.asarray(sequence)[keep])
     summary = summarize(oracle)
     interval = bootstrap_interval(oracle, n_bootstrap, seed)
-    return NoiseFloor(trans_pct=summary["trans_pct"], rot_pct=summary["rot_pct"],
-                      interval={key: interval[key] for key in ("trans_pct", "rot_pct")}, source=source,
+    return NoiseFloor(trans_percent=summary["trans_percent"], rot_percent=summary["rot_percent"],
+                      interval={key: interval[key] for key in ("trans_percent", "rot_percent")}, source=source,
                       n_windows=int(keep.sum()))
 
 

@@ -237,7 +237,7 @@ def close_loop(
         floor = metrics.noise_floor(test.target, test.sequence, test.push, test.window, test.tracking_noise,
                                     settings.n_bootstrap, seed)
         after = measured(model_test)
-        above = {key: after[key] - getattr(floor, key) for key in ("trans_pct", "rot_pct")}
+        above = {key: after[key] - getattr(floor, key) for key in ("trans_percent", "rot_percent")}
         explained = all(after[key] <= floor.interval[key][1] for key in above)
         stages.update()
 

@@ -7,15 +7,12 @@ import json
 import math
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from pushjax.loop import diagnose as diagnose_lib  # noqa: E402
-from pushjax.loop.metrics import METRIC_KEYS  # noqa: E402
-from pushjax.loop.windows import CATEGORICAL, VARIABLES, Examples  # noqa: E402
+from pushjax.loop import diagnose as diagnose_lib
+from pushjax.loop.metrics import METRIC_KEYS
+from pushjax.loop.windows import CATEGORICAL, VARIABLES, Examples
 
 FIGURE_DIR = "figures"
 
@@ -79,9 +76,9 @@ def strength_figure(path: Path, before: list, after: list) -> None:
 
 
 def _metrics_row(label: str, summary: dict) -> str:
-    low, high = (sum(bound) for bound in zip(summary["interval"]["trans_pct"], summary["interval"]["rot_pct"]))
-    return (f"| {label} | {summary['trans_pct']:.1f} | {summary['rot_pct']:.1f} | {summary['trans_mm']:.3f} "
-            f"| {summary['rot_deg']:.3f} | {summary['trans_pct'] + summary['rot_pct']:.1f} ({low:.1f}–{high:.1f}) |")
+    low, high = (sum(bound) for bound in zip(summary["interval"]["trans_percent"], summary["interval"]["rot_percent"]))
+    return (f"| {label} | {summary['trans_percent']:.1f} | {summary['rot_percent']:.1f} | {summary['trans_mm']:.3f} "
+            f"| {summary['rot_deg']:.3f} | {summary['trans_percent'] + summary['rot_percent']:.1f} ({low:.1f}–{high:.1f}) |")
 
 
 def _params_text(params: dict) -> str:
@@ -144,7 +141,7 @@ def markdown(report: dict, details: dict) -> str:
               "## Effects ranked by select-split error (each fitted alone)", "",
               "| effect | parameters (± standard error) | sum % | translation mm | rotation deg |", "|---|---|---|---|---|"]
     lines += [f"| {entry['effect']} | {_params_text(entry['params'])} | "
-              f"{entry['select']['trans_pct'] + entry['select']['rot_pct']:.1f} | {entry['select']['trans_mm']:.3f} | "
+              f"{entry['select']['trans_percent'] + entry['select']['rot_percent']:.1f} | {entry['select']['trans_mm']:.3f} | "
               f"{entry['select']['rot_deg']:.3f} |" for entry in report["ranking"]]
     friction, sensor = report["pusher_friction"], report["pusher_friction"]["force_sensor"]
     lines += ["", "## Pusher friction from the force sensor", "",
@@ -162,7 +159,7 @@ def markdown(report: dict, details: dict) -> str:
               f"Every candidate of a round is tested: its gain on the select split must be beyond noise (one-sided "
               f"sign-flip tests over select push sequences, Holm's procedure over the round's candidates at the "
               f"family-wise level {details['alpha']:g}) and remove more than {details['min_gain']:g} of the current "
-              f"error above the select split's noise floor ({select_floor['trans_pct'] + select_floor['rot_pct']:.1f} "
+              f"error above the select split's noise floor ({select_floor['trans_percent'] + select_floor['rot_percent']:.1f} "
               f"% from {select_floor['source']}); of those that pass, the largest gain is added.", ""]
     for k, round_ in enumerate(details["rounds"], 1):
         best = round_["accepted"] or max(round_["gains"], key=round_["gains"].get)
@@ -190,9 +187,9 @@ def markdown(report: dict, details: dict) -> str:
     floor, above = report["noise_floor"], report["remaining"]["above_floor"]
     lines.append(
         f"Noise floor of the test split (from {floor['source']}, {floor['n_windows']} windows): translation "
-        f"{floor['trans_pct']:.1f} % ({floor['interval']['trans_pct'][0]:.1f}–{floor['interval']['trans_pct'][1]:.1f}),"
-        f" rotation {floor['rot_pct']:.1f} % ({floor['interval']['rot_pct'][0]:.1f}–"
-        f"{floor['interval']['rot_pct'][1]:.1f}).")
+        f"{floor['trans_percent']:.1f} % ({floor['interval']['trans_percent'][0]:.1f}–{floor['interval']['trans_percent'][1]:.1f}),"
+        f" rotation {floor['rot_percent']:.1f} % ({floor['interval']['rot_percent'][0]:.1f}–"
+        f"{floor['interval']['rot_percent'][1]:.1f}).")
     lines.append("")
     if report["explained"]:
         lines.append("**Explained:** the selected model's test error is within the noise floor's interval.")
@@ -200,12 +197,12 @@ def markdown(report: dict, details: dict) -> str:
         remaining = ", ".join(f"**{entry['variable']}** (a correction for it removes {entry['strength']:.1%} of the "
                               "error)" for entry in report["remaining"]["variables"]) or "no single variable"
         lines.append(
-            f"**Not explained:** the selected model's test error is {above['trans_pct']:.1f} (translation) and "
-            f"{above['rot_pct']:.1f} (rotation) points of % above the noise floor; the learned error term "
+            f"**Not explained:** the selected model's test error is {above['trans_percent']:.1f} (translation) and "
+            f"{above['rot_percent']:.1f} (rotation) points of % above the noise floor; the learned error term "
             f"{'lowers' if fallback['beyond_noise'] else 'does not lower'} the error beyond noise, and the residual "
             f"still depends on {remaining}. Test-split sum with the learned term "
-            f"{report['fallback']['trans_pct'] + report['fallback']['rot_pct']:.1f} % instead of "
-            f"{report['after']['trans_pct'] + report['after']['rot_pct']:.1f} %.")
+            f"{report['fallback']['trans_percent'] + report['fallback']['rot_percent']:.1f} % instead of "
+            f"{report['after']['trans_percent'] + report['after']['rot_percent']:.1f} %.")
     return "\n".join(lines) + "\n"
 
 

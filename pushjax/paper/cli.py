@@ -4,7 +4,9 @@ Importing this module defines the flags (absl's global ``FLAGS``); ``experiments
 `spec_from_flags` is the one place where flags become an `ExperimentSpec`; each binary is
 ``main(argv) -> cli.main(<name>, argv)``, which runs the spec (`run_spec`: `pushjax.paper.runner.run`), writes its
 tables and figures and ends with one line saying what it wrote where. A bad flag is an ``app.UsageError`` naming
-the flag, raised before any dataset is built or model trained.
+the flag, raised before any dataset is built or model trained. ``--config.<field>=<value>`` replaces any field of the
+training config (`pushjax.train.configs.OVERRIDABLE_FIELDS`, e.g. ``--config.learning_rate=3e-4``,
+``--config.model.head_features=64,32``); the overrides are recorded in ``results.json``'s ``config``.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from pushjax.data import configs as data_configs
 from pushjax.paper import figures, paths, reference, runner, spec as spec_lib, tables, visualize
 from pushjax.sim import testbed
 from pushjax.train import SWEEP_MODES, distributed
+from pushjax.train import configs as train_configs
 
 SCALE = flags.DEFINE_enum("scale", data_configs.DEFAULT_SCALE, data_configs.SCALES, "Dataset and training scale.")
 WORKDIR = flags.DEFINE_string("workdir", None, "Output folder: checkpoints, results.json, results.md, figures.")
@@ -32,6 +35,13 @@ COORDINATOR_ADDRESS = flags.DEFINE_string(
     "coordinator_address", None, "Several processes (hosts): host:port of process 0, which coordinates them.")
 NUM_PROCESSES = flags.DEFINE_integer("num_processes", 1, "Processes (one per host) that train together.")
 PROCESS_ID = flags.DEFINE_integer("process_id", 0, "This process's index in [0, --num_processes).")
+CONFIG_OVERRIDES = {
+    path: flags.DEFINE_string(f"config.{path}", None, f"Replace the training config's {path} "
+                              f"({field_type.__name__ if field_type in (int, float, str) else 'comma-separated integers'}; default: the "
+                              "scale's).")
+    for path, field_type in train_configs.OVERRIDABLE_FIELDS.items()
+}
+"""``--config.<field>=<value>`` (Flax / big_vision style): any training-config field, recorded in results.json."""
 
 
 def spec_from_flags(setup: spec_lib.Setup) -> spec_lib.ExperimentSpec:
@@ -52,6 +62,7 @@ def spec_from_flags(setup: spec_lib.Setup) -> spec_lib.ExperimentSpec:
             setup, SCALE.value, models=VARIANTS_FLAG.value, sizes=SIZES.value, seeds=SEEDS.value,
             num_steps=NUM_STEPS.value, data_dir=DATA_DIR.value, build=BUILD.value, workers=WORKERS.value,
             mode=MODE.value, testbed=TESTBED.value,
+            config_overrides={path: flag.value for path, flag in CONFIG_OVERRIDES.items() if flag.value is not None},
         )
     except ValueError as error:
         raise app.UsageError(f"--{error}") from error

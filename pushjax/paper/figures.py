@@ -6,13 +6,11 @@ import os
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-import matplotlib
+import matplotlib.colors
+import matplotlib.pyplot as plt
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from pushjax.paper import reference, tables  # noqa: E402
+from pushjax.paper import reference, tables
 
 PANELS = (("trans_percent", "translation error [% of zero]"), ("rot_percent", "rotation error [% of zero]"))
 MODEL_ORDER = ("zero", "physics", "neural", "neural_dyn", "hybrid", "simple", "error", "error_grad", "error_norm")

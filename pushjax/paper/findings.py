@@ -242,7 +242,7 @@ def _crossover(results: Results):
     run = _data_efficiency(results)
     found = crossover(run)
     sizes, largest = found["sizes"], found["sizes"][-1]
-    text = (f"neural − hybrid by size: " + ", ".join(f"{size}: {d}" for size, d in zip(sizes, found["differences"]))
+    text = ("neural − hybrid by size: " + ", ".join(f"{size}: {d}" for size, d in zip(sizes, found["differences"]))
             + f"; first size where neural is better by {MARGIN:g} s.e.: "
             + ("none" if found["decided"] is None else str(found["decided"]))
             + f"; crossing (log-size interpolation): {_size_text(found['estimate'], largest)}")
@@ -293,7 +293,7 @@ def _error_velocities(results: Results):
         raise _Missing("needs models trained on more than one velocity")
     one = _degradation(run, "train_20", ("hybrid", "error"))
     comparisons = [_compare("train_20: hybrid − error", one["hybrid"], one["error"])]
-    parts = [f"train_20: " + _listing(one)]
+    parts = ["train_20: " + _listing(one)]
     for split in several:
         more = _degradation(run, split, ("error",))
         comparisons.append(_compare(f"error {split} − train_20", more["error"], one["error"]))

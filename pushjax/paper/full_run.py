@@ -32,7 +32,7 @@ import numpy as np
 
 from pushjax import train as train_lib
 from pushjax.models import ModelConfig
-from pushjax.paper import runner, spec as spec_lib
+from pushjax.paper import paths, runner, spec as spec_lib
 from pushjax.train import convergence, evaluate
 
 NAME = "data_efficiency_full"
@@ -126,14 +126,22 @@ def train_config(spec: spec_lib.ExperimentSpec, unit: Unit) -> train_lib.TrainCo
 
 def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Mapping, validation: Mapping,
                test: Mapping, criterion: convergence.Criterion = convergence.CRITERION,
-               log: Callable[[str], None] | None = None) -> dict:
-    """Trains and evaluates one model; returns its record."""
+               log: Callable[[str], None] | None = None, tensorboard_dir: str | Path | None = None) -> dict:
+    """Trains and evaluates one model; returns its record. With `tensorboard_dir`, the model's scores go to the
+    TensorBoard run ``<tensorboard_dir>/<unit key>/train`` (restarted with the model)."""
     count = len(train_examples["motion"])
     size = min(unit.size, count)
     (model_spec,) = train_lib.subset_specs(count, (size,), (unit.seed,))
     config = train_config(spec, unit)
     started = datetime.datetime.now(datetime.timezone.utc)
-    trained = convergence.train_until_converged(config, train_examples, model_spec, validation, criterion, log=log)
+    tensorboard = (None if tensorboard_dir is None else
+                   train_lib.metrics_log.TensorBoardLog(tensorboard_dir, [unit.key], "train", first_step=0))
+    try:
+        trained = convergence.train_until_converged(config, train_examples, model_spec, validation, criterion, log=log,
+                                                    tensorboard=tensorboard)
+    finally:
+        if tensorboard is not None:
+            tensorboard.close()
     clock = time.monotonic()
     metrics = evaluate.evaluate(trained.model, trained.state, test, config.eval_batch_size)
     row = {"model": unit.model, "kind": "trained", "train_split": "train", "test_split": "test",
@@ -148,7 +156,7 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Mappin
         "parameters": int(sum(np.size(leaf) for leaf in jax.tree.leaves(trained.state.params))),
         "train_seconds": round(trained.seconds, 1), "eval_seconds": round(time.monotonic() - clock, 1),
         "steps_per_second": trained.steps_per_second, "started": started.isoformat(timespec="seconds"),
-        "commit": runner._git_commit(),
+        **({"commit": commit} if (commit := paths.git_commit()) else {}),
     })
 
 
@@ -176,7 +184,8 @@ def assemble(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence
     return {"name": NAME, "config": config, "rows": rows, "curves": curves,
             "progress": {"planned": len(units), "done": sum(unit.key in done for unit in units),
                          "missing": [unit.key for unit in units if unit.key not in done]},
-            "provenance": {"commit": runner._git_commit(), "model_seconds": round(train_seconds, 1)}}
+            "provenance": {**({"commit": commit} if (commit := paths.git_commit()) else {}),
+                           "model_seconds": round(train_seconds, 1)}}
 
 
 def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit], *,
@@ -218,7 +227,8 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
                 break
             log(f"{NAME}: training {unit.key} (budget {criterion.budget(min(unit.size, len(train_examples['motion'])))}"
                 " constant-rate steps)")
-            record = train_unit(spec, unit, train_examples, validation, test, criterion, log)
+            record = train_unit(spec, unit, train_examples, validation, test, criterion, log,
+                                workdir / train_lib.metrics_log.TENSORBOARD_DIR)
             _write_json(workdir / "models" / f"{unit.key}.json", record)
             trained += 1
             row = record["row"]

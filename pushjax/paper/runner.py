@@ -16,14 +16,16 @@ standard errors, `pushjax.paper.statistics`). Besides ``rows``:
 * ``curves``: the learning curves, [{"model", "train_split", "train_size", "seed", "l_scale", "step", "split"
   ("train": the model's own training examples, or "validation"), "trans_percent", "rot_percent"}, ...]
   (`pushjax.train.curves`; a dataset without a validation split gives the training curve only);
-* ``provenance``: {"commit": the git commit of the code (with ``+changes`` when the tree differed from it),
+* ``provenance``: {"commit": the git commit of the code (with ``+changes`` when the tree differed from it; absent
+  when unknown, e.g. for an installed pushjax, `pushjax.paper.paths.git_commit`),
   "invocations": [{"commit", "started" (UTC, ISO 8601), "wall_s", "finished"}, ...] every call of `run` on this
   work directory, a resumed one included, "wall_s": their sum}. A call is recorded in
   ``<workdir>/invocations.jsonl`` when it starts and brought up to date after every sweep, so a call that was
   stopped counts up to its last finished sweep (``"finished": false``).
 
-Each sweep trains in ``<workdir>/<train_split>/l<l_scale>/<variants>`` (checkpoints, ``metrics.csv`` and
-``curves.csv``), so an interrupted run resumes where it stopped.
+Each sweep trains in ``<workdir>/<train_split>/l<l_scale>/<variants>`` (checkpoints, ``metrics.csv``,
+``curves.csv`` and TensorBoard event files under ``tensorboard/``), so an interrupted run resumes where it stopped;
+``tensorboard --logdir=<workdir>`` shows every model of every sweep.
 """
 
 from __future__ import annotations
@@ -33,7 +35,6 @@ import datetime
 import json
 import math
 import os
-import subprocess
 import time
 import warnings
 from collections.abc import Mapping, Sequence
@@ -158,7 +159,7 @@ def train_sweep(spec: ExperimentSpec, variants: Sequence[str], train_examples: E
     config = spec.train_config(variants[0])
     learning_curves = curves_lib.LearningCurves(
         Path(workdir) / "curves.csv", PushModel(config.model), specs, train_examples, curve_sets or {},
-        config.curve_examples, config.eval_batch_size)
+        config.curve_examples, config.eval_batch_size, Path(workdir) / train_lib.metrics_log.TENSORBOARD_DIR)
     return train_lib.sweep(config, train_examples, specs, workdir, mode=spec.mode, progress=progress,
                            description=description, checkpoint_callback=learning_curves)
 
@@ -207,33 +208,20 @@ def _curve_rows(sweep: TrainedSweep, workdir: Path) -> list[dict]:
             for row in curves_lib.read(path)]
 
 
-def _git_commit() -> str | None:
-    """The code's git commit, ``+changes`` appended when the work tree differs from it; None outside git."""
-    root = Path(__file__).resolve().parents[2]
-    try:
-        commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True, text=True,
-                                check=True).stdout.strip()
-        changed = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root,
-                                 capture_output=True, text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return None
-    return commit + ("+changes" if changed else "")
-
-
 def _record_sitting(workdir: Path, commit: str | None, started: datetime.datetime, wall_s: float,
                     finished: bool) -> dict:
     """Writes this call of `run` (of the code at `commit`) into ``<workdir>/invocations.jsonl``, replacing its
     earlier record, and returns the provenance of ``results.json``: every call's record and their wall time."""
     workdir.mkdir(parents=True, exist_ok=True)
     log = workdir / "invocations.jsonl"
-    record = {"commit": commit, "started": started.isoformat(timespec="seconds"),
+    record = {**({} if commit is None else {"commit": commit}), "started": started.isoformat(timespec="seconds"),
               "wall_s": round(wall_s, 1), "finished": finished}
     invocations = [json.loads(line) for line in log.read_text().splitlines() if line.strip()] if log.exists() else []
     invocations = [entry for entry in invocations if entry["started"] != record["started"]] + [record]
     partial = log.with_name(log.name + ".partial")
     partial.write_text("".join(json.dumps(entry) + "\n" for entry in invocations))
     partial.replace(log)
-    return {"commit": record["commit"], "invocations": invocations,
+    return {**({} if commit is None else {"commit": commit}), "invocations": invocations,
             "wall_s": round(sum(entry["wall_s"] for entry in invocations), 1)}
 
 
@@ -261,7 +249,7 @@ def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True)
     workdir = Path(workdir)
     started, clock = datetime.datetime.now(datetime.timezone.utc), time.monotonic()
     writer = train_lib.distributed.is_writer()
-    commit = _git_commit() if writer else None
+    commit = paths.git_commit() if writer else None
 
     def record_sitting(finished: bool = False) -> dict | None:
         return _record_sitting(workdir, commit, started, time.monotonic() - clock, finished) if writer else None

@@ -12,7 +12,7 @@ import dataclasses
 import functools
 import json
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import jax
@@ -120,6 +120,7 @@ class ExperimentSpec:
     build: bool
     workers: int | None
     mode: str
+    config_overrides: tuple[tuple[str, str], ...] = ()
 
     @property
     def scale(self) -> str:
@@ -164,6 +165,7 @@ class ExperimentSpec:
             "l_scaled_models": None if self.l_scaled_models is None else list(self.l_scaled_models),
             "num_steps": self.train.num_steps, "mode": self.mode, "data_dir": self.data_dir,
             "dataset": dataclasses.asdict(self.dataset), "train": train,
+            "config_overrides": dict(self.config_overrides),
         }
         if self.test_dataset != self.dataset:
             config["test_dataset"] = dataclasses.asdict(self.test_dataset)
@@ -235,7 +237,7 @@ def make_spec(
     setup: Setup, scale: str = data_configs.DEFAULT_SCALE, *, models: Sequence[str] = (),
     sizes: Sequence[int | str] = (), seeds: Sequence[int | str] = (0,), num_steps: int | None = None,
     data_dir: str | os.PathLike | None = None, build: bool = True, workers: int | None = None,
-    mode: str | None = None, testbed: str = DEFAULT_PROFILE,
+    mode: str | None = None, testbed: str = DEFAULT_PROFILE, config_overrides: Mapping[str, str] | None = None,
 ) -> ExperimentSpec:
     """The `ExperimentSpec` of `setup` with the user's choices; raises ``ValueError`` naming a bad one.
 
@@ -251,6 +253,8 @@ def make_spec(
       workers: dataset build processes (None: the builder's default).
       mode: sweep mode (None: `default_mode`).
       testbed: the testbed profile the datasets are simulated with (`pushjax.sim.testbed.PROFILES`).
+      config_overrides: training-config fields replaced after the scale's config and `num_steps`, as text
+        (`pushjax.train.configs.override`: ``{"learning_rate": "3e-4", "model.head_features": "64,32"}``).
     """
     models = parse_models(models or setup.models)
     sizes = parse_sizes(sizes or setup.sizes)
@@ -268,6 +272,7 @@ def make_spec(
                     else dataset)
     train = train_configs.get_config(dataset)
     train = dataclasses.replace(train, num_steps=num_steps or train.num_steps)
+    train = train_configs.override(train, config_overrides or {})
     return ExperimentSpec(
         name=setup.name, dataset=dataset, test_dataset=test_dataset, train=train,
         variants=tuple(model for model in models if model in VARIANTS),
@@ -275,5 +280,5 @@ def make_spec(
         train_splits=setup.train_splits, test_splits=setup.test_splits, sizes=sizes, seeds=seeds,
         l_scales=setup.l_scales, l_scaled_models=setup.l_scaled_models, test_fields=setup.test_fields,
         data_dir=None if data_dir is None else os.fspath(data_dir), build=build, workers=workers,
-        mode=mode or default_mode(),
+        mode=mode or default_mode(), config_overrides=tuple((config_overrides or {}).items()),
     )

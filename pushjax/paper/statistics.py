@@ -5,7 +5,7 @@ value is the mean over seeds, and two sources of uncertainty make its standard e
 
 * **sequences**: which push sequences happen to be in the test split. The windows of one sequence are not
   independent, so the unit is the sequence: a bootstrap over the test split's sequences
-  (`pushjax.train.evaluate.bootstrap_replicates`) of the mean over seeds, every seed resampled alike.
+  (`pushjax.stats.bootstrap_replicates`) of the mean over seeds, every seed resampled alike.
 * **seeds**: the training randomness (training subset and initialisation): the spread of the per-seed values,
   sd / sqrt(n). Baselines have no seed and no such part.
 
@@ -22,7 +22,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from pushjax.train.evaluate import SEQUENCE_RATIOS, bootstrap_replicates
+from pushjax.stats import SEQUENCE_RATIOS, bootstrap_replicates
 
 SCORE = "score"
 """The findings' summary metric: the mean of ``trans_percent`` and ``rot_percent``."""

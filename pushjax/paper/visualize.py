@@ -11,17 +11,14 @@ import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from pushjax import planar  # noqa: E402
-from pushjax.models import ERROR_OPTIONS  # noqa: E402
-from pushjax.paper import runner  # noqa: E402
-from pushjax.train import evaluate  # noqa: E402
-from pushjax.train.batching import ModelSpec  # noqa: E402
+from pushjax import planar
+from pushjax.models import ERROR_OPTIONS
+from pushjax.paper import runner
+from pushjax.train import evaluate
+from pushjax.train.batching import ModelSpec
 
 
 

@@ -220,7 +220,11 @@ class ModelState:
     drift_force: jax.Array
 
 
-@dataclasses.dataclass(frozen=True)
+def _identity(params: Params) -> Params:
+    return params
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Effect:
     """One library effect (see the module docstring for the physics of each).
 
@@ -228,10 +232,10 @@ class Effect:
       name: library name.
       init: the "no effect" parameters, {name: zeros of the parameter's shape}.
       typical: {name: typical magnitude}, for conditioning optimisers.
-      modify: (params, state, inputs) -> state, applied before the solve, or None.
-      correct: (params, twist, state, inputs) -> twist, applied to the predicted twist of the push, or None;
-        with several, their changes add up (each sees the push's twist, not another's correction).
-      project: params -> params inside the physically valid set.
+      modify: (params, state, inputs) -> state, applied before the solve, or None (the default).
+      correct: (params, twist, state, inputs) -> twist, applied to the predicted twist of the push, or None (the
+        default); with several, their changes add up (each sees the push's twist, not another's correction).
+      project: params -> params inside the physically valid set (default: all parameters are valid).
       physical: params -> {readable name with unit: scalar}, the values to report.
       general_solver: whether the effect needs the generalised solver (not plain Lynch).
       solve: (params, state, inputs) -> twist about the centre of friction, replacing the ellipsoidal solve, or
@@ -244,11 +248,11 @@ class Effect:
     name: str
     init: Callable[[], Params]
     typical: dict[str, float]
-    modify: Callable[[Params, ModelState, PushInputs], ModelState] | None
-    correct: Callable[[Params, jax.Array, ModelState, PushInputs], jax.Array] | None
-    project: Callable[[Params], Params]
     physical: Callable[[Params], dict[str, jax.Array]]
-    general_solver: bool
+    modify: Callable[[Params, ModelState, PushInputs], ModelState] | None = None
+    correct: Callable[[Params, jax.Array, ModelState, PushInputs], jax.Array] | None = None
+    project: Callable[[Params], Params] = _identity
+    general_solver: bool = False
     solve: Callable[[Params, ModelState, PushInputs], jax.Array] | None = None
     excludes: tuple[str, ...] = ()
     per_object: bool = False
@@ -275,10 +279,6 @@ def _safe_norm(vector: jax.Array) -> tuple[jax.Array, jax.Array]:
 def _safe_sqrt(value: jax.Array) -> jax.Array:
     positive = value > 0
     return jnp.where(positive, jnp.sqrt(jnp.where(positive, value, 1.0)), 0.0)
-
-
-def _identity(params: Params) -> Params:
-    return params
 
 
 # --------------------------------------------------------------------------------------------------
@@ -500,29 +500,32 @@ def _zeros(**shapes):
 EFFECTS: dict[str, Effect] = {
     effect.name: effect
     for effect in (
-        Effect("frame_offset", _zeros(offset=(2,)), {"offset": 0.01}, _frame_offset_modify, None,
-               _identity, _offset_physical, False, per_object=True),
-        Effect("cof_offset", _zeros(offset=(2,)), {"offset": 0.01}, _cof_offset_modify, None,
-               _identity, _offset_physical, False, per_object=True),
-        Effect("friction_ratio", _zeros(log_scale=()), {"log_scale": 0.3}, _friction_ratio_modify, None,
-               _identity, lambda p: {"scale": jnp.exp(p["log_scale"])}, False, per_object=True),
-        Effect("anisotropic_friction", _zeros(log_metric=(2,)), {"log_metric": 0.5},
-               _anisotropic_friction_modify, None, _identity, _anisotropic_friction_physical, True),
-        Effect("pusher_friction", _zeros(log_scale=()), {"log_scale": 0.5}, _pusher_friction_modify, None,
-               _identity, lambda p: {"mu_scale": jnp.exp(p["log_scale"])}, False),
-        Effect("table_tilt", _zeros(drift_force=(2,)), {"drift_force": 0.2}, _table_tilt_modify, None,
-               _table_tilt_project, _table_tilt_physical, True),
-        Effect("inertia", _zeros(inverse_deceleration=()), {"inverse_deceleration": 0.3}, None,
-               _inertia_correct, _inertia_project, _inertia_physical, False),
-        Effect("friction_field", _zeros(gradient=(2,), curvature=(3,)), {"gradient": 3.0, "curvature": 30.0},
-               _friction_field_modify, None, _identity, _friction_field_physical, False),
-        Effect("friction_speed", _zeros(inverse_deceleration=(), gain=()), {"inverse_deceleration": 0.3, "gain": 0.3},
-               None, _friction_speed_correct, _friction_speed_project, _friction_speed_physical, False),
-        Effect("pressure_gradient", _zeros(offset=(2,)), {"offset": 0.01}, _pressure_gradient_modify, None,
-               _identity, _pressure_gradient_physical, False, per_object=True),
-        Effect("limit_surface", _zeros(rim=()), {"rim": 1.0}, None, None,
-               _identity, _limit_surface_physical, False, solve=_limit_surface_solve,
-               excludes=("friction_ratio", "pressure_gradient", "anisotropic_friction"), per_object=True),
+        Effect(name="frame_offset", init=_zeros(offset=(2,)), typical={"offset": 0.01}, modify=_frame_offset_modify,
+               physical=_offset_physical, per_object=True),
+        Effect(name="cof_offset", init=_zeros(offset=(2,)), typical={"offset": 0.01}, modify=_cof_offset_modify,
+               physical=_offset_physical, per_object=True),
+        Effect(name="friction_ratio", init=_zeros(log_scale=()), typical={"log_scale": 0.3},
+               modify=_friction_ratio_modify, physical=lambda p: {"scale": jnp.exp(p["log_scale"])}, per_object=True),
+        Effect(name="anisotropic_friction", init=_zeros(log_metric=(2,)), typical={"log_metric": 0.5},
+               modify=_anisotropic_friction_modify, physical=_anisotropic_friction_physical, general_solver=True),
+        Effect(name="pusher_friction", init=_zeros(log_scale=()), typical={"log_scale": 0.5},
+               modify=_pusher_friction_modify, physical=lambda p: {"mu_scale": jnp.exp(p["log_scale"])}),
+        Effect(name="table_tilt", init=_zeros(drift_force=(2,)), typical={"drift_force": 0.2},
+               modify=_table_tilt_modify, project=_table_tilt_project, physical=_table_tilt_physical,
+               general_solver=True),
+        Effect(name="inertia", init=_zeros(inverse_deceleration=()), typical={"inverse_deceleration": 0.3},
+               correct=_inertia_correct, project=_inertia_project, physical=_inertia_physical),
+        Effect(name="friction_field", init=_zeros(gradient=(2,), curvature=(3,)),
+               typical={"gradient": 3.0, "curvature": 30.0}, modify=_friction_field_modify,
+               physical=_friction_field_physical),
+        Effect(name="friction_speed", init=_zeros(inverse_deceleration=(), gain=()),
+               typical={"inverse_deceleration": 0.3, "gain": 0.3}, correct=_friction_speed_correct,
+               project=_friction_speed_project, physical=_friction_speed_physical),
+        Effect(name="pressure_gradient", init=_zeros(offset=(2,)), typical={"offset": 0.01},
+               modify=_pressure_gradient_modify, physical=_pressure_gradient_physical, per_object=True),
+        Effect(name="limit_surface", init=_zeros(rim=()), typical={"rim": 1.0}, physical=_limit_surface_physical,
+               solve=_limit_surface_solve, excludes=("friction_ratio", "pressure_gradient", "anisotropic_friction"),
+               per_object=True),
     )
 }
 """The library, in the order in which effects are applied."""

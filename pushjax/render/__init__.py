@@ -1,8 +1,8 @@
 """Cameras of the pushing scene (pure JAX, :mod:`~pushjax.render.camera`); this package exports only them.
 
 The offscreen MuJoCo depth / point-cloud renderer is imported explicitly, so that camera maths never loads
-MuJoCo: ``from pushjax.render.renderer import DepthRenderer`` (it sets ``MUJOCO_GL=egl`` unless the variable is
-already set).
+MuJoCo: ``from pushjax.render.renderer import DepthRenderer`` (it chooses the OpenGL backend when the first
+renderer is made).
 """
 
 from pushjax.render.camera import (

@@ -15,7 +15,6 @@ is a `Camera` whose array fields carry a leading batch axis, mapped with `jax.vm
 
 from __future__ import annotations
 
-import math
 from typing import Literal, Sequence
 
 import jax

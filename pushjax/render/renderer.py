@@ -7,27 +7,27 @@ Scene naming convention (shared with `pushjax.sim`):
 * mocap body `pusher`: the pusher (a vertical cylinder);
 * camera `camera`: a fixed camera attached to the world body.
 
-Rendering runs headless through EGL by default (`MUJOCO_GL=egl`). The variable is read once, when
-`mujoco` is first imported anywhere in the process, so set it before importing anything that imports
-mujoco if you need another backend.
+The OpenGL backend is chosen where rendering starts, when the first `DepthRenderer` is made
+(`choose_gl_backend`): ``MUJOCO_GL`` when it is set, else the first of `GL_BACKENDS` that works (headless EGL
+first); importing pushjax sets nothing.
 """
 
 from __future__ import annotations
 
 import copy
+import functools
+import importlib
+import inspect
 import os
 import weakref
+from typing import Literal
 
-os.environ.setdefault("MUJOCO_GL", "egl")
+import jax
+import jax.numpy as jnp
+import mujoco
+import numpy as np
 
-from typing import Literal  # noqa: E402
-
-import jax  # noqa: E402
-import jax.numpy as jnp  # noqa: E402
-import mujoco  # noqa: E402
-import numpy as np  # noqa: E402
-
-from pushjax.render.camera import Camera, point_cloud_from_depth  # noqa: E402
+from pushjax.render.camera import Camera, point_cloud_from_depth
 
 TABLE_GEOM = "table"
 OBJECT_BODY = "object"
@@ -39,6 +39,39 @@ PUSHER_CLEARANCE_M = 1e-3
 """Gap between the table top and the lowest point of the pusher [m], so the two never z-fight."""
 
 _INTRINSICS_TOLERANCE_PX = 1e-3
+
+GL_BACKENDS = ("egl", "osmesa", "glfw")
+"""The OpenGL backends (values of ``MUJOCO_GL``) tried in turn when the variable is unset."""
+
+
+@functools.cache
+def choose_gl_backend() -> str:
+    """The OpenGL backend of MuJoCo's offscreen rendering in this process, chosen on first use.
+
+    ``MUJOCO_GL`` when set, else the first of `GL_BACKENDS` that renders; ``MUJOCO_GL`` is then set to it,
+    so that processes started later (dataset build workers) inherit it. MuJoCo reads the variable when its
+    OpenGL-context module loads (at ``import mujoco``), so that module is reloaded when the choice differs.
+
+    Raises:
+      RuntimeError: one line naming every backend tried and why it failed.
+    """
+    requested = os.environ.get("MUJOCO_GL")
+    # The module whose `GLContext` mujoco.Renderer instantiates (its path differs between MuJoCo versions).
+    gl_context = inspect.getmodule(mujoco.Renderer).gl_context
+    failures = []
+    for backend in (requested,) if requested else GL_BACKENDS:
+        os.environ["MUJOCO_GL"] = backend
+        try:
+            if getattr(gl_context, "_MUJOCO_GL", backend) != backend.lower():
+                gl_context = importlib.reload(gl_context)
+            mujoco.Renderer(mujoco.MjModel.from_xml_string("<mujoco/>"), height=1, width=1).close()
+            return backend
+        except Exception as error:  # each backend fails in its own way (ImportError, RuntimeError, GLError, ...)
+            failures.append(f"MUJOCO_GL={backend}: {' '.join(str(error).split()) or type(error).__name__}")
+    if not requested:
+        del os.environ["MUJOCO_GL"]
+    raise RuntimeError(f"no OpenGL backend for MuJoCo's offscreen rendering works ({'; '.join(failures)}); "
+                       "headless machines need EGL (BUILD.md: libegl1 libegl-mesa0 libgl1-mesa-dri)")
 
 
 def _object_id(model: mujoco.MjModel, object_type: mujoco.mjtObj, name: str, what: str) -> int:
@@ -151,13 +184,11 @@ class DepthRenderer:
         global_visual.offwidth = max(global_visual.offwidth, camera.width)
         global_visual.offheight = max(global_visual.offheight, camera.height)
         self._data = mujoco.MjData(self.model)
+        backend = choose_gl_backend()
         try:
             self._renderer = mujoco.Renderer(self.model, height=camera.height, width=camera.width)
         except mujoco.FatalError as error:
-            raise RuntimeError(
-                "could not create an OpenGL context; run headless with MUJOCO_GL=egl set before mujoco is "
-                f"first imported (it is {os.environ.get('MUJOCO_GL')!r} now)"
-            ) from error
+            raise RuntimeError(f"could not create an OpenGL context with MUJOCO_GL={backend}: {error}") from error
         # Frees the OpenGL context when the renderer is collected, and at the latest at interpreter exit
         # (atexit), while the modules that freeing needs still exist: mujoco.Renderer's own __del__ would run
         # during module teardown and print a traceback there.

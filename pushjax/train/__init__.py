@@ -8,7 +8,8 @@ Modules:
   mesh: the sweep's model axis split over a mesh of devices (K/D models per device).
   distributed: several processes (hosts) joined to train one sweep.
   checkpoint: orbax checkpoints of a (stacked) train state.
-  metrics_log: the sweep's ``metrics.csv``.
+  metrics_log: the sweep's ``metrics.csv`` and TensorBoard event files.
+  predictor: `load_model`, a trained model from its checkpoint, predicting from depth images or point clouds.
   curves: learning curves (training and validation error against steps), the sweep's ``curves.csv``.
   losses, evaluate, configs: the training losses, evaluation in the paper's units, configs.
 """
@@ -23,6 +24,7 @@ from pushjax.train import (
     losses,
     mesh,
     metrics_log,
+    predictor,
     sweep_trainer,
     train_state,
 )
@@ -37,6 +39,7 @@ from pushjax.train.batching import (
     subset_specs,
 )
 from pushjax.train.configs import TrainConfig, get_config
+from pushjax.train.predictor import Prediction, Predictor, load_model
 from pushjax.train.train_state import TrainState, create_train_state, make_optimizer, make_train_step
 from pushjax.train.sweep_trainer import SWEEP_MODES, SweepResult, describe_specs, sweep
 
@@ -50,12 +53,15 @@ __all__ = [
     "losses",
     "mesh",
     "metrics_log",
+    "predictor",
     "sweep_trainer",
     "train_state",
     "EVALUATION_FIELDS",
     "MODEL_INPUT_FIELDS",
     "SWEEP_MODES",
     "ModelSpec",
+    "Prediction",
+    "Predictor",
     "SweepResult",
     "TrainConfig",
     "TrainState",
@@ -65,6 +71,7 @@ __all__ = [
     "examples_from_source",
     "gather",
     "get_config",
+    "load_model",
     "make_optimizer",
     "make_train_step",
     "model_fields",

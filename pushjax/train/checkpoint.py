@@ -36,15 +36,17 @@ class Checkpointer:
     """Saves and restores ``(state, metadata)`` pairs under ``directory/<step>``.
 
     Args:
-      directory: the checkpoint folder (created when missing).
+      directory: the checkpoint folder (created when missing, unless `read_only`).
       max_to_keep: newest checkpoints kept on disk.
+      read_only: only restore; the folder is never written (e.g. a user's trained model, `pushjax.train.predictor`).
     """
 
-    def __init__(self, directory: str | os.PathLike, max_to_keep: int = 2):
+    def __init__(self, directory: str | os.PathLike, max_to_keep: int = 2, read_only: bool = False):
         self._manager = ocp.CheckpointManager(
             os.path.abspath(directory),
             options=ocp.CheckpointManagerOptions(
-                max_to_keep=max_to_keep, enable_async_checkpointing=False, create=True
+                max_to_keep=None if read_only else max_to_keep, enable_async_checkpointing=False,
+                create=not read_only, read_only=read_only, save_interval_steps=0 if read_only else 1,
             ),
             item_names=("state", "metadata"),
         )
@@ -64,6 +66,10 @@ class Checkpointer:
             force=True,
         )
         self._manager.wait_until_finished()
+
+    def all_steps(self) -> list[int]:
+        """Steps of the complete checkpoints, oldest first."""
+        return sorted(self._manager.all_steps())
 
     def latest_metadata(self) -> dict | None:
         """The metadata of the newest checkpoint (without reading its state), or None."""
@@ -91,6 +97,13 @@ class Checkpointer:
             ),
         )
         return step, restored.state, restored.metadata
+
+    def restore_arrays(self, step: int) -> tuple[Any, dict]:
+        """(state, metadata) of the checkpoint at `step`, the state as saved (nested dicts of NumPy arrays), without
+        needing its structure beforehand."""
+        restored = self._manager.restore(
+            step, args=ocp.args.Composite(state=ocp.args.StandardRestore(), metadata=ocp.args.JsonRestore()))
+        return restored.state, restored.metadata
 
     def close(self) -> None:
         self._manager.close()

@@ -22,7 +22,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 
 import jax
 import jax.numpy as jnp
@@ -33,6 +33,7 @@ from pushjax.models import PushModel
 from pushjax.train.batching import Examples, ModelSpec, batch_indices, gather, model_fields
 from pushjax.train.configs import TrainConfig
 from pushjax.train.evaluate import error_metrics, predict
+from pushjax.train.metrics_log import TensorBoardLog
 from pushjax.train.train_state import TrainState, create_train_state, make_train_step
 
 
@@ -135,7 +136,7 @@ def _with_learning_rate(state: TrainState, value: float) -> TrainState:
 def train_until_converged(
     train_config: TrainConfig, examples: Examples, spec: ModelSpec, validation: Examples,
     criterion: Criterion = CRITERION, *, physics: Callable | None = None,
-    log: Callable[[str], None] | None = None,
+    log: Callable[[str], None] | None = None, tensorboard: TensorBoardLog | None = None,
 ) -> ConvergedModel:
     """Trains one model (`train_config.model`, the subset and seed of `spec`) by `criterion`.
 
@@ -148,6 +149,9 @@ def train_until_converged(
       criterion: the convergence criterion and budget.
       physics: replaces `PushModel.physics`.
       log: called with a line after every validation score.
+      tensorboard: a log of this one model (`pushjax.train.metrics_log.TensorBoardLog`) that gets every validation
+        score (``validation/trans_percent``, ``validation/rot_percent``, ``validation/score``), the training loss and
+        the steps per second of the constant phase, or None.
     """
     model = PushModel(train_config.model) if physics is None else PushModel(train_config.model, physics)
     optimizer = optax.inject_hyperparams(optax.adam)(learning_rate=train_config.learning_rate)
@@ -166,10 +170,14 @@ def train_until_converged(
     started, train_seconds = time.monotonic(), 0.0
     step, converged = 0, False
 
-    def score_now(label: str) -> float:
+    def score_now(label: str, scalars: dict[str, float]) -> float:
         trans, rot = validation_errors(model, state, validation, train_config.eval_batch_size)
         score = (trans + rot) / 2.0
         history.append((step, trans, rot))
+        if tensorboard is not None:
+            scalars = {**scalars, "validation/trans_percent": trans, "validation/rot_percent": rot,
+                       "validation/score": score}
+            tensorboard.append(step, {tag: np.array([value]) for tag, value in scalars.items()})
         if log is not None:
             log(f"{spec.name}: step {step} ({label}) validation score {score:.2f}")
         return score
@@ -181,7 +189,8 @@ def train_until_converged(
             step += 1
         jax.block_until_ready(state.params)
         train_seconds += time.monotonic() - chunk
-        scores.append(score_now("constant"))
+        scores.append(score_now("constant", {"loss": float(metrics["loss"]),
+                                             "steps_per_second": criterion.eval_every / (time.monotonic() - chunk)}))
         if criterion.plateaued(scores):
             converged = True
             break
@@ -198,6 +207,6 @@ def train_until_converged(
         step += 1
     jax.block_until_ready(state.params)
     train_seconds += time.monotonic() - chunk
-    score_now("after the decay")
+    score_now("after the decay", {"loss": float(metrics["loss"])} if decay_steps else {})
     return ConvergedModel(model, state, converged, constant_steps, decay_steps, history,
                           time.monotonic() - started, step / train_seconds if train_seconds > 0 else float("nan"))

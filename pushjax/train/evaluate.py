@@ -4,8 +4,8 @@
   the ``zero`` baseline's (predicting no motion) on the same examples, with standard errors ``*_se``.
   The windows of one push sequence are not independent (they share the object, the push and its
   unmodelled physics), so with the examples' ``sequence_id`` the standard error is a bootstrap over push
-  sequences (`sequence_bootstrap_weights`: the ratio of summed errors to summed zero errors over
-  resampled sequences), and the per-sequence sums are returned under ``sequences`` so that results can
+  sequences (`pushjax.stats.sequence_bootstrap_weights`: the ratio of summed errors to summed zero errors over
+  resampled sequences, `pushjax.stats`), and the per-sequence sums are returned under ``sequences`` so that results can
   be averaged over seeds and compared pairwise on the same resamples (`pushjax.paper.statistics`).
   Without ``sequence_id``, or with a single sequence (the ``repeated`` push under many scene transforms), the
   examples count as independent.
@@ -19,19 +19,18 @@
 from __future__ import annotations
 
 import functools
-import zlib
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 
 import jax
 import numpy as np
 
 from pushjax import planar
+from pushjax.stats import SEQUENCE_RATIOS, bootstrap_replicates
 from pushjax.models import ERROR_OPTIONS, PushModel
 from pushjax.physics import lynch
 from pushjax.train.batching import Examples, model_fields
 from pushjax.train.sweep_trainer import SweepResult
 from pushjax.train.train_state import TrainState
-
 
 
 def predict(
@@ -69,46 +68,6 @@ def _apply_eval(model: PushModel, variables, batch, error_options):
 def _angle_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     cosine = np.sum(a * b, -1) / (np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1))
     return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
-
-
-BOOTSTRAP_SAMPLES = 2000
-"""Resamples of the push sequences behind every sequence-bootstrap standard error."""
-
-SEQUENCE_RATIOS = {
-    "trans_percent": ("trans_mm", "trans_zero_mm", 100.0),
-    "rot_percent": ("rot_deg", "rot_zero_deg", 100.0),
-    "pos_mm": ("pos_mm", "count", 1.0),
-    "contact_mm": ("contact_mm", "contact_count", 1.0),
-    "normal_deg": ("normal_deg", "normal_count", 1.0),
-    "s": ("s", "count", 1.0),
-    "push_velocity_deg": ("push_velocity_deg", "push_velocity_count", 1.0),
-}
-"""metric -> (numerator, denominator, factor): the metric is factor * sum(numerator) / sum(denominator) over the
-per-sequence sums of ``sequences`` (so a resample of the sequences gives a bootstrap replicate of it)."""
-
-
-def sequence_bootstrap_weights(ids: Sequence[int], samples: int = BOOTSTRAP_SAMPLES) -> np.ndarray:
-    """[samples, S] how often each of the S sequences `ids` is drawn in each bootstrap resample.
-
-    Seeded by the ids, so every model evaluated on one test split is resampled identically (differences between
-    models are paired) and different splits independently.
-    """
-    ids = np.asarray(ids, np.int64)
-    rng = np.random.default_rng([len(ids), samples, zlib.crc32(ids.tobytes())])
-    return rng.multinomial(len(ids), np.full(len(ids), 1.0 / len(ids)), size=samples).astype(np.float64)
-
-
-def bootstrap_replicates(sequences: Mapping[str, Sequence[float]], metric: str) -> np.ndarray:
-    """[BOOTSTRAP_SAMPLES] replicates of `metric` (a key of `SEQUENCE_RATIOS`) over resampled sequences.
-
-    Args:
-      sequences: the ``sequences`` of `error_metrics`: {"id": [S], "count": [S], per-sequence sums: [S]}.
-      metric: e.g. ``"trans_percent"``.
-    """
-    numerator, denominator, factor = SEQUENCE_RATIOS[metric]
-    weights = sequence_bootstrap_weights(sequences["id"])
-    return factor * (weights @ np.asarray(sequences[numerator], np.float64)) / (
-        weights @ np.asarray(sequences[denominator], np.float64))
 
 
 def _sequence_sums(sequence_id: np.ndarray, **per_example: np.ndarray) -> dict[str, list]:

@@ -1,19 +1,28 @@
-"""``metrics.csv``: the training metrics of a sweep, one row per logged step and model.
+"""The training logs of a sweep: ``metrics.csv`` and TensorBoard event files.
 
-Columns: ``step`` (steps completed), ``model`` (index into the sweep's models), ``name`` (the model's
+``metrics.csv`` (`MetricsLog`), one row per logged step and model. Columns: ``step`` (steps completed), ``model`` (index into the sweep's models), ``name`` (the model's
 label) and the loss's metrics (``loss`` and its terms in mm / degrees, see `pushjax.train.losses`),
 written with 6 significant digits. A resumed sweep keeps the rows up to its restored step and appends
 after them, so the file of a killed and resumed run equals that of an uninterrupted one.
+
+``tensorboard/`` (`TensorBoardLog`, written with tensorboardX, no TensorFlow): one TensorBoard run per model and
+stream, ``tensorboard/<model name>/<stream>`` (``train``: the loss and its terms and steps per second, with the
+training config as hparams; ``curves``: the learning curves of `pushjax.train.curves`). A resumed log marks the
+step it resumes from, so TensorBoard drops what the killed run wrote from there on (its ``purge_step``), as
+``metrics.csv`` drops those rows: ``tensorboard --logdir=<workdir>`` shows every sweep of a run.
 """
 
 from __future__ import annotations
 
 import csv
+import dataclasses
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
+from tensorboardX import SummaryWriter
+from tensorboardX.summary import hparams as hparams_summary
 
 
 class MetricsLog:
@@ -60,3 +69,58 @@ class MetricsLog:
              **{metric: f"{float(values[k]):.6g}" for metric, values in metrics.items()}}
             for k, name in enumerate(names)
         ])
+
+
+TENSORBOARD_DIR = "tensorboard"
+"""The TensorBoard folder of a sweep's work directory."""
+HParams = Mapping[str, "int | float | str | bool"]
+
+
+class TensorBoardLog:
+    """Scalars of K models, one TensorBoard run each: ``<folder>/<model name>/<stream>``.
+
+    Args:
+      folder: the sweep's TensorBoard folder (``<workdir>/tensorboard``).
+      names: [K] the models' labels.
+      stream: the runs' last folder, e.g. ``train`` or ``curves``.
+      first_step: the first step this log writes. Events an earlier (killed) run wrote at this step or later are
+        dropped when TensorBoard reads the runs; with 0, the runs' event files are removed first.
+    """
+
+    def __init__(self, folder: str | os.PathLike, names: Sequence[str], stream: str, first_step: int):
+        self._writers = []
+        for name in names:
+            logdir = Path(folder) / name / stream
+            if first_step == 0:
+                for events in logdir.glob("events.out.tfevents.*"):
+                    events.unlink()
+            self._writers.append(SummaryWriter(str(logdir), purge_step=first_step or None))
+
+    def write_hparams(self, hparams: Sequence[HParams], metric_tags: Sequence[str]) -> None:
+        """Each model's hyperparameters ({name: int, float, str or bool}), linked to the scalars `metric_tags`."""
+        for writer, model_hparams in zip(self._writers, hparams, strict=True):
+            for summary in hparams_summary(dict(model_hparams), dict.fromkeys(metric_tags, 0.0)):
+                writer.file_writer.add_summary(summary)
+
+    def append(self, step: int, scalars: Mapping[str, np.ndarray]) -> None:
+        """Writes {tag: [K] values} at `step`, one value per model, and flushes them to disk."""
+        for k, writer in enumerate(self._writers):
+            for tag, values in scalars.items():
+                writer.add_scalar(tag, float(values[k]), step)
+            writer.flush()
+
+    def close(self) -> None:
+        for writer in self._writers:
+            writer.close()
+
+
+def flat_hparams(config: object, prefix: str = "") -> dict[str, int | float | str | bool]:
+    """A (nested) dataclass as TensorBoard hparams: ``{"learning_rate": 1e-3, "model.head_features": "(64, 32)"}``."""
+    flat = {}
+    for field in dataclasses.fields(config):
+        value = getattr(config, field.name)
+        if dataclasses.is_dataclass(value):
+            flat.update(flat_hparams(value, f"{prefix}{field.name}."))
+        else:
+            flat[prefix + field.name] = value if isinstance(value, (int, float, str, bool)) else str(value)
+    return flat

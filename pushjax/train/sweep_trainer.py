@@ -29,8 +29,10 @@ resumed from a checkpoint replays exactly the batches of an uninterrupted run an
 parameters, and a model trained alone draws the same batches as inside a sweep.
 
 Work directory layout: ``checkpoints/<step>/`` (orbax, `pushjax.train.checkpoint`: the stacked
-`TrainState` and metadata identifying the models) and ``metrics.csv`` (one row per logged step and
-model: step, model, name, loss and the loss's metrics in mm / degrees; `pushjax.train.metrics_log`).
+`TrainState` and metadata: the models' identity and, under `MODEL_CONFIG_KEY` and `MODEL_VARIANTS_KEY`, their `ModelConfig` and variants, which
+`pushjax.train.predictor.load_model` rebuilds them from) ``metrics.csv`` (one row per logged step and
+model: step, model, name, loss and the loss's metrics in mm / degrees; `pushjax.train.metrics_log`) and
+``tensorboard/<model name>/train`` (the same scalars and steps per second, the training config as hparams).
 """
 
 from __future__ import annotations
@@ -38,6 +40,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import os
+import time
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -54,11 +57,15 @@ from pushjax.train import distributed, mesh as mesh_lib
 from pushjax.train.batching import Examples, ModelSpec, batch_indices, gather, model_fields
 from pushjax.train.checkpoint import Checkpointer
 from pushjax.train.configs import TrainConfig
-from pushjax.train.metrics_log import MetricsLog
+from pushjax.train.metrics_log import TENSORBOARD_DIR, MetricsLog, TensorBoardLog, flat_hparams
 from pushjax.train.train_state import TrainState, create_train_state, make_optimizer, make_train_step
 
 SWEEP_MODES = ("vmap", "unroll", "sequential")
 """How `sweep` steps its K models (see the module docstring)."""
+MODEL_CONFIG_KEY = "model_config"
+"""The checkpoint metadata's key of the models' `ModelConfig` (as `dataclasses.asdict`)."""
+MODEL_VARIANTS_KEY = "model_variants"
+"""The checkpoint metadata's key of each model's variant (they differ in a sweep that mixes the error variants)."""
 
 
 def _error_options(config: ModelConfig, specs: Sequence[ModelSpec]) -> jax.Array | None:
@@ -122,6 +129,80 @@ def _compiled_step(
         return _stack([state for state, _ in outputs]), _stack([metrics for _, metrics in outputs])
 
     return jax.jit(unrolled_step if mesh is None else mesh_lib.map_models(unrolled_step, mesh))
+
+
+class _SequentialStepper:
+    """``sequential``: the jitted single-model step once per model, the K states kept apart."""
+
+    def __init__(self, step_fn: Callable, state: TrainState, specs: Sequence[ModelSpec], options: jax.Array | None):
+        self._step_fn, self._options, self.local_specs = step_fn, options, list(specs)
+        self._models = _unstack(state, len(specs))
+
+    def advance(self, batches: Sequence[Mapping[str, np.ndarray]]) -> dict[str, jax.Array]:
+        """One step of every model on its batch; the [K] metrics."""
+        outputs = [self._step_fn(model, batch, None if self._options is None else self._options[k])
+                   for k, (model, batch) in enumerate(zip(self._models, batches))]
+        self._models = [model for model, _ in outputs]
+        return _stack([metrics for _, metrics in outputs])
+
+    def state(self) -> TrainState:
+        """The K models' stacked state."""
+        return _stack(self._models)
+
+
+class _StackedStepper:
+    """``vmap`` / ``unroll`` on one device: one jitted step of the stacked state."""
+
+    def __init__(self, step_fn: Callable, state: TrainState, specs: Sequence[ModelSpec], options: jax.Array | None,
+                 fields: Sequence[str]):
+        self._step_fn, self._options, self._fields, self.local_specs = step_fn, options, fields, list(specs)
+        self._state = state
+
+    def advance(self, batches: Sequence[Mapping[str, np.ndarray]]) -> dict[str, jax.Array]:
+        batch = {name: np.stack([b[name] for b in batches]) for name in self._fields}
+        self._state, metrics = self._step_fn(self._state, batch, self._options)
+        return metrics
+
+    def state(self) -> TrainState:
+        return self._state
+
+
+class _ShardedStepper:
+    """``vmap`` / ``unroll`` over a device mesh: the model axis padded to a multiple of the devices and sharded;
+    this process steps its own rows (`mesh_lib.local_rows`), a padding row repeating the last model."""
+
+    def __init__(self, step_fn: Callable, state: TrainState, specs: Sequence[ModelSpec], options: jax.Array | None,
+                 fields: Sequence[str], mesh: Mesh):
+        self._step_fn, self._fields, self._mesh, self._count = step_fn, fields, mesh, len(specs)
+        self._padded = mesh_lib.padded_count(len(specs), mesh)
+        self._options = None if options is None else mesh_lib.shard(mesh_lib.pad(options, self._padded),
+                                                                    self._padded, mesh)
+        self._state = mesh_lib.shard(mesh_lib.pad(state, self._padded), self._padded, mesh)
+        self.local_specs = [specs[min(row, len(specs) - 1)] for row in mesh_lib.local_rows(self._padded, mesh)]
+
+    def advance(self, batches: Sequence[Mapping[str, np.ndarray]]) -> dict[str, jax.Array]:
+        batch = {name: np.stack([b[name] for b in batches]) for name in self._fields}
+        self._state, metrics = self._step_fn(self._state, mesh_lib.shard(batch, self._padded, self._mesh),
+                                             self._options)
+        return mesh_lib.unshard(metrics, self._count, self._mesh)
+
+    def state(self) -> TrainState:
+        return mesh_lib.unshard(self._state, self._count, self._mesh)
+
+
+def _make_stepper(mode: str, step_fn: Callable, state: TrainState, specs: Sequence[ModelSpec],
+                  options: jax.Array | None, fields: Sequence[str], mesh: Mesh | None):
+    """The stepper of `mode` (one of `SWEEP_MODES`) starting from the K models' stacked `state`.
+
+    Each has ``local_specs`` (the models whose batches this process draws, in row order), ``advance(batches)`` (one
+    step; returns the K models' {name: [K]} metrics) and ``state()`` (the K models' stacked `TrainState`, on one
+    device).
+    """
+    if mode == "sequential":
+        return _SequentialStepper(step_fn, state, specs, options)
+    if mesh is not None:
+        return _ShardedStepper(step_fn, state, specs, options, fields, mesh)
+    return _StackedStepper(step_fn, state, specs, options, fields)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -233,7 +314,7 @@ def sweep(
 
     state = _stack([create_train_state(model, optimizer, example_batch, spec.seed) for spec in specs])
     start = 0
-    checkpointer = log = None
+    checkpointer = log = tensorboard = None
     names = [spec.name for spec in specs]
     identity = {
         "names": names,
@@ -242,6 +323,8 @@ def sweep(
         "subset_checksums": [int(np.asarray(spec.train_indices, np.int64).sum()) for spec in specs],
         "variant": model_config.variant,
     }
+    checkpoint_metadata = {"identity": identity, MODEL_CONFIG_KEY: dataclasses.asdict(model_config),
+                           MODEL_VARIANTS_KEY: [spec.variant or model_config.variant for spec in specs]}
     if workdir is not None:
         workdir = Path(workdir)
         workdir.mkdir(parents=True, exist_ok=True)
@@ -262,58 +345,46 @@ def sweep(
                     stacklevel=2)
         if distributed.is_writer():
             log = MetricsLog(workdir / "metrics.csv", start)
-    if mode == "sequential":
-        def advance(models, batches):
-            outputs = [step_fn(models[k], batches[k], None if options is None else options[k])
-                       for k in range(len(specs))]
-            return [model_state for model_state, _ in outputs], _stack([metrics for _, metrics in outputs])
-
-        models, stacked, local_specs = _unstack(state, len(specs)), _stack, specs
-    elif mesh is not None:
-        padded = mesh_lib.padded_count(len(specs), mesh)
-        if options is not None:
-            options = mesh_lib.shard(mesh_lib.pad(options, padded), padded, mesh)
-
-        def advance(models, batches):
-            batch = {name: np.stack([b[name] for b in batches]) for name in fields}
-            models, metrics = step_fn(models, mesh_lib.shard(batch, padded, mesh), options)
-            return models, mesh_lib.unshard(metrics, len(specs), mesh)
-
-        models = mesh_lib.shard(mesh_lib.pad(state, padded), padded, mesh)
-        stacked = functools.partial(mesh_lib.unshard, count=len(specs), mesh=mesh)
-        # This process's rows of the padded model axis; a padding row repeats the last model.
-        local_specs = [specs[min(row, len(specs) - 1)] for row in mesh_lib.local_rows(padded, mesh)]
-    else:
-        def advance(models, batches):
-            return step_fn(models, {name: np.stack([b[name] for b in batches]) for name in fields}, options)
-
-        models, stacked, local_specs = state, lambda stacked_state: stacked_state, specs
-
-    if checkpoint_callback is not None and start < train_config.num_steps:
-        checkpoint_callback(start, stacked(models))
+            tensorboard = TensorBoardLog(workdir / TENSORBOARD_DIR, names, "train", start and start + 1)
+            config_hparams = flat_hparams(train_config)
+            tensorboard.write_hparams(
+                [{**config_hparams, "seed": spec.seed, "train_size": len(spec.train_indices),
+                  "variant": spec.variant or model_config.variant} for spec in specs], ("loss",))
+    stepper = _make_stepper(mode, step_fn, state, specs, options, fields, mesh)
     metrics = None
-    with tqdm.tqdm(
-        total=train_config.num_steps, initial=start, disable=not progress or not distributed.is_writer(),
-        desc=description or describe_specs(model_config.variant, specs),
-    ) as bar:
-        for step in range(start, train_config.num_steps):
-            models, metrics = advance(models, [batch_at(spec, step) for spec in local_specs])
-            done = step + 1
-            bar.update(1)
-            if done % train_config.log_every == 0 or done == train_config.num_steps:
-                host_metrics = jax.tree.map(np.asarray, metrics)
-                bar.set_postfix(loss=f"{host_metrics['loss'].mean():.3f}")
-                if log is not None:
-                    log.append(done, names, host_metrics)
-            if done % train_config.checkpoint_every == 0 or done == train_config.num_steps:
-                snapshot = stacked(models)
-                if checkpointer is not None:
-                    checkpointer.save(done, snapshot, {"identity": identity})
-                if checkpoint_callback is not None:
-                    checkpoint_callback(done, snapshot)
-            if step_callback is not None:
-                step_callback(done, metrics)
-    if checkpointer is not None:
-        checkpointer.close()
+    try:
+        if checkpoint_callback is not None and start < train_config.num_steps:
+            checkpoint_callback(start, stepper.state())
+        last_log = (start, time.perf_counter())
+        with tqdm.tqdm(
+            total=train_config.num_steps, initial=start, disable=not progress or not distributed.is_writer(),
+            desc=description or describe_specs(model_config.variant, specs),
+        ) as bar:
+            for step in range(start, train_config.num_steps):
+                metrics = stepper.advance([batch_at(spec, step) for spec in stepper.local_specs])
+                done = step + 1
+                bar.update(1)
+                if done % train_config.log_every == 0 or done == train_config.num_steps:
+                    host_metrics = jax.tree.map(np.asarray, metrics)
+                    bar.set_postfix(loss=f"{host_metrics['loss'].mean():.3f}")
+                    if log is not None:
+                        log.append(done, names, host_metrics)
+                        steps_per_second = (done - last_log[0]) / (time.perf_counter() - last_log[1])
+                        tensorboard.append(
+                            done, {**host_metrics, "steps_per_second": np.full(len(specs), steps_per_second)})
+                    last_log = (done, time.perf_counter())
+                if done % train_config.checkpoint_every == 0 or done == train_config.num_steps:
+                    snapshot = stepper.state()
+                    if checkpointer is not None:
+                        checkpointer.save(done, snapshot, checkpoint_metadata)
+                    if checkpoint_callback is not None:
+                        checkpoint_callback(done, snapshot)
+                if step_callback is not None:
+                    step_callback(done, metrics)
+    finally:
+        if checkpointer is not None:
+            checkpointer.close()
+        if tensorboard is not None:
+            tensorboard.close()
     final_metrics = {} if metrics is None else jax.tree.map(np.asarray, metrics)
-    return SweepResult(model, list(specs), stacked(models), final_metrics)
+    return SweepResult(model, list(specs), stepper.state(), final_metrics)

@@ -9,7 +9,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import tensorflow_datasets as tfds
 
 from pushjax.data import configs
 from pushjax.data.builder import IncompleteRawDirError, PushEffects, build, load

@@ -58,9 +58,9 @@ def test_noise_floor_from_repeats_is_the_error_of_the_true_expected_motion():
     floor = metrics.noise_floor(target, sequence, push, window, np.zeros((len(target), 3)))
     oracle = metrics.summarize(metrics.window_errors(expected, target, sequence))
     assert floor.source == "repeats" and floor.n_windows == len(target)
-    assert abs(floor.trans_pct - oracle["trans_pct"]) < 0.05 * oracle["trans_pct"]
-    assert abs(floor.rot_pct - oracle["rot_pct"]) < 0.05 * oracle["rot_pct"]
-    for key in ("trans_pct", "rot_pct"):
+    assert abs(floor.trans_percent - oracle["trans_percent"]) < 0.05 * oracle["trans_percent"]
+    assert abs(floor.rot_percent - oracle["rot_percent"]) < 0.05 * oracle["rot_percent"]
+    for key in ("trans_percent", "rot_percent"):
         low, high = floor.interval[key]
         assert low < getattr(floor, key) < high
 
@@ -74,5 +74,5 @@ def test_noise_floor_without_repeats_comes_from_the_tracking_noise():
     floor = metrics.noise_floor(measured, sequence, push, window, np.broadcast_to(noise, target.shape))
     oracle = metrics.summarize(metrics.window_errors(expected, measured, sequence))
     assert floor.source == "tracking"
-    assert abs(floor.trans_pct - oracle["trans_pct"]) < 0.1 * oracle["trans_pct"]
-    assert abs(floor.rot_pct - oracle["rot_pct"]) < 0.1 * oracle["rot_pct"]
+    assert abs(floor.trans_percent - oracle["trans_percent"]) < 0.1 * oracle["trans_percent"]
+    assert abs(floor.rot_percent - oracle["rot_percent"]) < 0.1 * oracle["rot_percent"]

@@ -19,7 +19,7 @@ from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
 
 from .conftest import CASES, KNOWN_FALSE_DISCOVERIES, REAL_DIFFERENCES
 
-SUMMARY_KEYS = {"trans_pct", "rot_pct", "trans_mm", "rot_deg"}
+SUMMARY_KEYS = {"trans_percent", "rot_percent", "trans_mm", "rot_deg"}
 SINGLE = [name for name, case in CASES.items() if case.effects != Effects() and case.expected and "_and_" not in name]
 MEASURED = [name for name, case in CASES.items() if case.pusher_friction != PUSHER_OBJECT_FRICTION]
 
@@ -55,7 +55,7 @@ def test_report_follows_the_schema(loop_report):
     floor = report["noise_floor"]
     assert floor["source"] == "tracking" and floor["n_windows"] > 0  # no push is repeated
     assert set(report["remaining"]) == {"above_floor", "variables"}
-    for key in ("trans_pct", "rot_pct"):
+    for key in ("trans_percent", "rot_percent"):
         assert 0 <= floor["interval"][key][0] <= floor[key] <= floor["interval"][key][1]
         assert report["remaining"]["above_floor"][key] == pytest.approx(report["after"][key] - floor[key])
     assert report["n_pushes"] == {"fit": 67, "select": 90, "test": 30, "skipped": 0}  # cross-fitted: every pool push selects

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from pushjax.paper import statistics, tables
+from pushjax import stats
 from pushjax.train import evaluate
 
 
@@ -71,7 +72,7 @@ def test_mean_over_independent_splits_shrinks_the_sequence_error():
 
 
 def test_bootstrap_is_deterministic_and_differs_between_splits():
-    first = evaluate.sequence_bootstrap_weights([1, 2, 3, 4])
-    assert np.array_equal(first, evaluate.sequence_bootstrap_weights([1, 2, 3, 4]))
-    assert not np.array_equal(first, evaluate.sequence_bootstrap_weights([5, 6, 7, 8]))
+    first = stats.sequence_bootstrap_weights([1, 2, 3, 4])
+    assert np.array_equal(first, stats.sequence_bootstrap_weights([1, 2, 3, 4]))
+    assert not np.array_equal(first, stats.sequence_bootstrap_weights([5, 6, 7, 8]))
     assert np.all(first.sum(axis=1) == 4)

@@ -141,8 +141,10 @@ def test_pusher_friction_acts_in_the_table_plane():
     data.qpos[7:9] = point - (PUSHER_RADIUS + 1e-3) * inward
     model.opt.timestep = 0.002
     forces = []
+    target = data.qpos[7:9].copy()
     for step in range(500):
-        target = data.qpos[7:9] if step == 0 else target + 0.02 * model.opt.timestep * inward
+        if step:
+            target = target + 0.02 * model.opt.timestep * inward
         data.ctrl[:] = [*target, *(0.02 * inward)]
         mujoco.mj_step(model, data)
         forces.append(data.sensordata[:3].copy())

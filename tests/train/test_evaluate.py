@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from pushjax import stats
 from pushjax.train import evaluate
 
 
@@ -28,9 +29,9 @@ def test_state_errors_are_bootstrapped_over_sequences(examples):
     assert sum(sequences["contact_count"]) == touching.sum()
     # The ratio of the per-sequence sums is the metric, and its standard error is the sequence bootstrap's.
     for metric in ("contact_mm", "normal_deg", "s", "push_velocity_deg"):
-        numerator, denominator, _ = evaluate.SEQUENCE_RATIOS[metric]
+        numerator, denominator, _ = stats.SEQUENCE_RATIOS[metric]
         assert sum(sequences[numerator]) / sum(sequences[denominator]) == pytest.approx(metrics[metric], rel=1e-6)
-        replicates = evaluate.bootstrap_replicates(sequences, metric)
+        replicates = stats.bootstrap_replicates(sequences, metric)
         assert metrics[f"{metric}_se"] == pytest.approx(replicates.std(ddof=1)) and metrics[f"{metric}_se"] > 0
     # Without sequence ids the examples count as independent.
     alone = evaluate.error_metrics(noisy, {k: v for k, v in examples.items() if k != "sequence_id"})

@@ -6,7 +6,7 @@ test error); the learning curves in RESULTS.md show where this schedule ends.
 """
 
 from pushjax.models import ModelConfig
-from pushjax.train.configs import TrainConfig
+from pushjax.train.configs.train_config import TrainConfig
 
 
 def get_config() -> TrainConfig:

@@ -7,8 +7,8 @@ training-set size). `pushjax.paper.full_run` trains with `pushjax.train.converge
 
 import dataclasses
 
-from pushjax.train.configs import TrainConfig
 from pushjax.train.configs import cpu
+from pushjax.train.configs.train_config import TrainConfig
 
 
 def get_config() -> TrainConfig:

@@ -5,7 +5,7 @@ With the paper-scale datasets' 80 x 80 px glimpses, the prediction part (glimpse
 """
 
 from pushjax.models import ModelConfig
-from pushjax.train.configs import TrainConfig
+from pushjax.train.configs.train_config import TrainConfig
 
 
 def get_config() -> TrainConfig:

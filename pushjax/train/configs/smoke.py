@@ -1,7 +1,7 @@
 """Smoke scale: tiny networks that train in seconds on 2 CPU cores (tests, CI)."""
 
 from pushjax.models import ModelConfig
-from pushjax.train.configs import TrainConfig
+from pushjax.train.configs.train_config import TrainConfig
 
 
 def get_config() -> TrainConfig:

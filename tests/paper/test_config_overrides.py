@@ -1,0 +1,39 @@
+"""``--config.<field>=<value>``: any training-config field replaced from the command line, recorded in results."""
+
+import json
+
+import pytest
+
+from pushjax.paper import spec as spec_lib
+from pushjax.train import configs as train_configs
+
+SETUP = spec_lib.SETUPS["data_efficiency"]
+
+
+def test_overrides_replace_fields_and_are_recorded():
+    spec = spec_lib.make_spec(SETUP, "smoke", num_steps=7, config_overrides={
+        "learning_rate": "3e-4", "model.head_features": "16,8", "schedule": "cosine", "batch_size": "4"})
+    assert (spec.train.learning_rate, spec.train.model.head_features, spec.train.schedule, spec.train.batch_size,
+            spec.train.num_steps) == (3e-4, (16, 8), "cosine", 4, 7)
+    assert spec.train_config("neural").model.head_features == (16, 8)
+    config = json.loads(json.dumps(spec.to_json()))
+    assert config["config_overrides"] == {"learning_rate": "3e-4", "model.head_features": "16,8",
+                                          "schedule": "cosine", "batch_size": "4"}
+    assert config["train"]["learning_rate"] == 3e-4 and config["train"]["model"]["head_features"] == [16, 8]
+    assert spec_lib.make_spec(SETUP, "smoke").to_json()["config_overrides"] == {}
+
+
+@pytest.mark.parametrize(("overrides", "message"), [
+    ({"batch_size": "x"}, "config.batch_size: expected an integer, got 'x'"),
+    ({"learning_rate": "fast"}, "config.learning_rate: expected a number, got 'fast'"),
+    ({"learning_rate": "-1"}, "config.learning_rate: expected > 0"),
+    ({"model.error_features": "1,b"}, "config.model.error_features: expected comma-separated integers"),
+    ({"model.glimpse_features": "8,8"}, "config.model.glimpse_features: expected 3 conv layers"),
+    ({"bogus": "1"}, "config.bogus: no such training-config field; expected one of model.glimpse_size"),
+    ({"model.variant": "neural"}, r"config.model.variant: no such training-config field \(set by the run itself\)"),
+])
+def test_bad_overrides_name_the_field(overrides, message):
+    with pytest.raises(ValueError, match=message) as error:
+        train_configs.override(train_configs.get_config(spec_lib.data_configs.get_config("data_efficiency", "smoke")),
+                               overrides)
+    assert "\n" not in str(error.value)
