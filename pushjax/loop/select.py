@@ -50,7 +50,7 @@ class Candidate:
       fits: per fold, the fit (None for the plain model).
       prediction: [N, 3] out-of-fold predictions on the selection windows (m, m, rad).
       errors: their per-window errors.
-      summary: {trans_pct, rot_pct, trans_mm, rot_deg} on the selection windows.
+      summary: {trans_percent, rot_percent, trans_mm, rot_deg} on the selection windows.
     """
 
     effects: tuple[str, ...]
