@@ -10,6 +10,10 @@ from pathlib import Path
 REPOSITORY = Path(__file__).resolve().parents[1]
 
 
+IMPORTED_BY_DEPENDENCIES = {"importlib-resources": "tensorflow-datasets imports it (through etils.epath) undeclared"}
+"""Declared for a dependency that imports it without declaring it: no pushjax module imports these."""
+
+
 def _normalise(name: str) -> str:
     return re.sub(r"[-_.]+", "-", name).lower()
 
@@ -48,4 +52,5 @@ def test_declared_dependencies_match_the_imports():
         else:
             undeclared[module] = path
     assert not undeclared, f"imported but not declared in pyproject.toml (module: a file importing it): {undeclared}"
-    assert declared - used == set(), f"declared in pyproject.toml but imported by no module: {declared - used}"
+    unused = declared - used - set(IMPORTED_BY_DEPENDENCIES)
+    assert unused == set(), f"declared in pyproject.toml but imported by no module: {unused}"
