@@ -94,7 +94,10 @@ class TensorBoardLog:
             if first_step == 0:
                 for events in logdir.glob("events.out.tfevents.*"):
                     events.unlink()
-            self._writers.append(SummaryWriter(str(logdir), purge_step=first_step or None))
+            # tensorboardX names a file by the second it was opened: a run resumed within the same second would
+            # overwrite the killed run's file without a suffix of its own (which also keeps the files in step order).
+            self._writers.append(SummaryWriter(str(logdir), purge_step=first_step or None,
+                                               filename_suffix=f".from_step_{first_step:010d}"))
 
     def write_hparams(self, hparams: Sequence[HParams], metric_tags: Sequence[str]) -> None:
         """Each model's hyperparameters ({name: int, float, str or bool}), linked to the scalars `metric_tags`."""
