@@ -6,7 +6,6 @@ Units in the report: mm and degrees for errors, m for the pusher's path, s for t
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -14,7 +13,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from pushjax import planar
+from pushjax import outputs, planar
 from pushjax.control import goals
 from pushjax.geometry.objects import PUSHER_RADIUS, get_object
 
@@ -117,10 +116,4 @@ def figure(results: dict, path: Path, count: int = 4) -> None:
 
 def write(results: dict, workdir: str | Path) -> list[Path]:
     """Writes ``results.json``, ``results.md`` and ``trajectories.png`` to `workdir`; returns their paths."""
-    workdir = Path(workdir)
-    workdir.mkdir(parents=True, exist_ok=True)
-    paths = [workdir / "results.json", workdir / "results.md", workdir / "trajectories.png"]
-    paths[0].write_text(json.dumps(results, indent=1))
-    paths[1].write_text(table(results))
-    figure(results, paths[2])
-    return paths
+    return outputs.write_results(workdir, results, table(results), "trajectories.png", figure)

@@ -20,7 +20,6 @@ done here.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import time
 from collections.abc import Sequence
@@ -30,6 +29,7 @@ import jax
 import matplotlib.pyplot as plt
 import numpy as np
 
+from pushjax import outputs
 from pushjax.filter import constant_velocity, ekf, metrics, models, particle, ukf
 from pushjax.sim import dataset
 from pushjax.sim.testbed import Testbed
@@ -270,10 +270,4 @@ def _figure(results: dict, path: Path, pushes: int = 4) -> None:
 
 def write(results: dict, workdir: str | Path) -> list[Path]:
     """Writes ``results.json``, ``results.md`` (the tables) and ``mu_over_time.png`` to `workdir`."""
-    workdir = Path(workdir)
-    workdir.mkdir(parents=True, exist_ok=True)
-    paths = [workdir / "results.json", workdir / "results.md", workdir / "mu_over_time.png"]
-    paths[0].write_text(json.dumps(results, indent=1))
-    paths[1].write_text(_table(results))
-    _figure(results, paths[2])
-    return paths
+    return outputs.write_results(workdir, results, _table(results), "mu_over_time.png", _figure)
