@@ -283,7 +283,9 @@ def close_loop(
             "rounds": [{"gains": dict(zip(r.additions, r.gains)), "p_values": dict(zip(r.additions, r.p_values)),
                         "levels": dict(zip(r.additions, r.levels)),
                         "beyond_noise": dict(zip(r.additions, r.beyond_noise)), "floor": r.floor,
-                        "mechanism": [dataclasses.asdict(check) for check in r.mechanism],
+                        "mechanism": [{**dataclasses.asdict(check), "p_value": check.p_value,
+                                       "variable": check.variable, "knob": check.is_knob(settings.alpha)}
+                                      for check in r.mechanism],
                         "accepted": r.accepted} for r in selection.rounds],
             "fallback_select": {"gain": decision.fallback_gain, "p_value": decision.fallback_p_value,
                                 "beyond_noise": decision.fallback_helps},

@@ -168,9 +168,13 @@ def markdown(report: dict, details: dict) -> str:
                      f"{round_['levels'][best]:.2g}); candidates beyond noise: "
                      f"{', '.join(name for name, passed in round_['beyond_noise'].items() if passed) or 'none'}")
         for check in round_["mechanism"]:
-            verdict = ("not testable here (one group, or too few sequences per group)" if check["p_value"] is None
-                       else f"p = {check['p_value']:.2g} for agreement across {check['variable']}: "
-                       + ("**a knob, not a mechanism**" if check["p_value"] <= details["alpha"] else "a mechanism"))
+            if check["p_value"] is None:
+                verdict = "not testable here (one group, or too few sequences per group)"
+            else:
+                worst = check["tests"][0]
+                verdict = (f"p = {worst['p_value']:.2g} for agreement of {worst['value']} across {worst['variable']}, "
+                           f"between-group spread {worst['relative_spread']:.2f} of the effect's size: "
+                           + ("**a knob, not a mechanism**" if check["knob"] else "a mechanism"))
             lines.append(f"   - mechanism check of `{check['effect']}`: {verdict}")
     if report["selected"]:
         lines += ["", "Fitted parameters of the selected model (every pool push):", ""]
