@@ -30,10 +30,9 @@ import dataclasses
 from collections.abc import Callable, Sequence
 
 import numpy as np
-from scipy import stats
 
 from pushjax.loop import fit as fit_lib
-from pushjax.loop import metrics
+from pushjax.loop import hierarchy, metrics
 from pushjax.loop.splits import Split
 from pushjax.loop.windows import Examples
 from pushjax.physics.effects import EFFECT_NAMES, EFFECTS
@@ -67,8 +66,6 @@ class Candidate:
 
 MECHANISM_GROUPS = ("object", "surface", "push velocity")
 """Variables whose values split the pool into groups on which an added effect's parameters must agree."""
-MIN_GROUP_SEQUENCES = 8
-"""Fewest pool sequences of a group for :func:`check_mechanism` to fit the effect on it."""
 MECHANISM_SPREAD = 0.5
 """Largest between-group spread of a value, over the effect's size, that still counts as one mechanism.
 
@@ -290,7 +287,7 @@ def check_mechanism(pool: Examples, effects: tuple[str, ...], added: str, settin
                     initial: dict) -> MechanismCheck:
     """Fits ``effects`` on the pool sequences of each group and tests whether ``added``'s values agree.
 
-    For each variable of :data:`MECHANISM_GROUPS` with at least two groups of :data:`MIN_GROUP_SEQUENCES` sequences
+    For each variable of :data:`MECHANISM_GROUPS` with at least two groups of :data:`pushjax.loop.hierarchy.MIN_GROUP_SEQUENCES` sequences
     (only ``surface`` and ``push velocity`` for a per-object effect) and each reported value: Cochran's Q over the
     groups (inverse-variance weights from the sandwich standard errors) against chi-square with groups - 1 degrees of
     freedom, Bonferroni-adjusted over the check's tests, and the DerSimonian-Laird between-group standard deviation
@@ -300,28 +297,21 @@ def check_mechanism(pool: Examples, effects: tuple[str, ...], added: str, settin
     neutral = {name: float(value) for name, value in EFFECTS[added].physical(EFFECTS[added].init()).items()}
     values, raw = {}, []
     for variable in variables:
-        labels = pool.variables[variable]
-        groups = [label for label in np.unique(labels)
-                  if len(np.unique(pool.sequence[labels == label])) >= MIN_GROUP_SEQUENCES]
-        if len(groups) < 2:
+        groups, fits = hierarchy.fit_groups(pool, effects, variable, settings, initial)
+        if not fits:
             continue
-        fits = [fit_lib.fit_effects([effects], pool.select(labels == label), settings, initial=[initial])[0]
-                for label in groups]
-        values[variable] = {str(label): result.physical[added] for label, result in zip(groups, fits)}
-        pooled, spread, p_values = {}, {}, {}
+        values[variable] = {label: result.physical[added] for label, result in zip(groups, fits)}
+        pooled = {}
         for name in fits[0].physical[added]:
             estimates = [result.physical[added][name] for result in fits]
             if any(estimate["std"] is None or not estimate["std"] > 0 for estimate in estimates):
                 continue
-            value = np.array([estimate["value"] for estimate in estimates])
-            weight = 1.0 / np.array([estimate["std"] for estimate in estimates]) ** 2
-            pooled[name] = float(np.sum(weight * value) / np.sum(weight))
-            q = float(np.sum(weight * (value - pooled[name]) ** 2))
-            tau_squared = max(0.0, (q - (len(groups) - 1)) / (np.sum(weight) - np.sum(weight ** 2) / np.sum(weight)))
-            spread[name], p_values[name] = float(np.sqrt(tau_squared)), float(stats.chi2.sf(q, len(groups) - 1))
-        for name in p_values:
-            raw.append((p_values[name], variable, name,
-                        spread[name] / max(_effect_size(name, pooled, neutral), np.finfo(float).tiny)))
+            pooled[name] = metrics.random_effects([estimate["value"] for estimate in estimates],
+                                                  [estimate["std"] for estimate in estimates])
+        centres = {name: result.fixed_mean for name, result in pooled.items()}
+        for name, result in pooled.items():
+            raw.append((result.p_value, variable, name,
+                        result.tau / max(_effect_size(name, centres, neutral), np.finfo(float).tiny)))
     tests = [Heterogeneity(variable=variable, value=name, p_value=min(1.0, p_value * len(raw)),
                            relative_spread=relative)
              for p_value, variable, name, relative in sorted(raw, key=lambda test: test[0])]
