@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import math
 from collections.abc import Sequence
 
 import flax.linen as nn
@@ -25,7 +24,7 @@ import numpy as np
 import optax
 
 from pushjax import planar
-from pushjax.loop.fit import PAD_MULTIPLE, zero_scales
+from pushjax.loop.fit import padded_size, zero_scales
 from pushjax.loop.windows import Examples, split_by_sequence
 
 
@@ -126,7 +125,7 @@ def fit_error_correction(
     residual = np.asarray(fit.target, np.float64) - np.asarray(prediction, np.float64)
     target = np.column_stack([planar.rotate(residual[:, :2], -yaw) / scales[0], residual[:, 2] / scales[1]])
     # Padded like the effect fits (zero weight), so that data sets of similar size share one program.
-    size = max(PAD_MULTIPLE, math.ceil(len(fit) / PAD_MULTIPLE) * PAD_MULTIPLE)
+    size = padded_size(len(fit))
     index = np.concatenate([np.arange(len(fit)), np.zeros(size - len(fit), int)])
     real = np.arange(size) < len(fit)
     x = jnp.asarray(((features - mean) / std)[index], jnp.float32)

@@ -15,11 +15,11 @@ from pathlib import Path
 import numpy as np
 import tqdm
 
-from pushjax import planar
 from pushjax.loop import correction as correction_lib
 from pushjax.loop import diagnose as diagnose_lib
 from pushjax.loop import force as force_lib
 from pushjax.loop import fit as fit_lib
+from pushjax.loop import hierarchy as hierarchy_lib
 from pushjax.loop import metrics
 from pushjax.loop import report as report_lib
 from pushjax.loop import select as select_lib
@@ -81,6 +81,10 @@ class Decision:
       diagnosis_before: the plain model's residual on the pool against the variables.
       diagnosis_after: the selected model's out-of-fold residual on the selection windows.
       noise: [3] standard deviation of that residual along the object's axes and of the rotation (m, m, rad).
+      selected_multipliers, fallback_multipliers: [L, 3] split-conformal half-widths of the
+        :data:`pushjax.loop.metrics.COVERAGE_LEVELS` intervals (:func:`pushjax.loop.metrics.interval_multipliers`), in
+        units of ``noise`` for the selected model and of the error term's own standard deviation for the fallback,
+        from their out-of-fold residuals on the selection windows.
       alpha: the level of the fallback's test.
     """
 
@@ -93,6 +97,8 @@ class Decision:
     diagnosis_before: list[diagnose_lib.Dependence]
     diagnosis_after: list[diagnose_lib.Dependence]
     noise: np.ndarray
+    selected_multipliers: np.ndarray
+    fallback_multipliers: np.ndarray
     alpha: float
 
     @property
@@ -137,22 +143,30 @@ def decide(examples: Examples, settings: LoopSettings = LoopSettings(), seed: in
                                           seed, report)
     final = selection.final
     report("fitting the learned error term on each fold")
-    means = []
+    means, stds = [], []
     for k, (fit_index, select_index) in enumerate(split.folds):
         fit, select = split.pool.select(fit_index), split.pool.select(select_index)
         result = final.fits[k]
         term = correction_lib.fit_error_correction(fit, fit_lib.predict([result], fit)[0], settings.correction, seed)
-        means.append(term(select, fit_lib.predict([result], select)[0])[0])
+        mean, std = term(select, fit_lib.predict([result], select)[0])
+        means.append(mean)
+        stds.append(std)
     selection_windows = split.pool.select(split.select_index)
     fallback = metrics.window_errors(np.concatenate(means), selection_windows.target, selection_windows.sequence)
     gains = metrics.sequence_gains(final.errors, [fallback])
     report("diagnosing the selected model")
     after = diagnose_lib.diagnose(selection_windows, final.prediction, variables, **diagnose)
-    residual = selection_windows.target - final.prediction
-    local = np.column_stack([planar.rotate(residual[:, :2], -selection_windows.inputs.object_yaw), residual[:, 2]])
+    yaw = np.asarray(selection_windows.inputs.object_yaw, np.float64)
+    local = metrics.standardised_residuals(final.prediction, np.ones_like(final.prediction), selection_windows.target,
+                                           yaw)
+    noise = np.sqrt(np.mean(local ** 2, axis=0))
+    fallback_z = metrics.standardised_residuals(np.concatenate(means), np.concatenate(stds), selection_windows.target,
+                                                yaw)
     return Decision(split=split, force=force, selection=selection, fallback_gain=float(gains.sum() / final.score),
                     fallback_p_value=float(metrics.sign_flip_pvalues(gains, seed=seed)[0]), variables=variables,
-                    diagnosis_before=before, diagnosis_after=after, noise=np.sqrt(np.mean(local ** 2, axis=0)),
+                    diagnosis_before=before, diagnosis_after=after, noise=noise,
+                    selected_multipliers=metrics.interval_multipliers(local / noise),
+                    fallback_multipliers=metrics.interval_multipliers(fallback_z),
                     alpha=settings.alpha)
 
 
@@ -223,6 +237,7 @@ def close_loop(
         split, selection = decision.split, decision.selection
         pool, test = split.pool, split.test
         model = selection.model
+        per_group = hierarchy_lib.hierarchical(pool, model, settings.fit) if model is not None else []
         term = correction_lib.fit_error_correction(pool, fit_lib.predict([model], pool)[0], settings.correction, seed)
         plain_test, model_test = fit_lib.predict([None, model], test)
         fallback_mean, fallback_std = term(test, model_test)
@@ -255,14 +270,17 @@ def close_loop(
                                 "from_force_sensor": settings.measure_pusher_friction and decision.force.measured,
                                 "used": float(pool.inputs.mu[0])},
             "explained": explained,
+            "per_group": [dataclasses.asdict(values) for values in per_group],
             "fallback": measured(fallback_mean),
             "remaining": {"above_floor": above,
                           "variables": [{"variable": d.variable, "strength": d.strength} for d in decision.remaining]},
             "uncertainty": {
-                "selected": {**metrics.predictive_scores(model_test, noise, test.target, yaw),
+                "selected": {**metrics.predictive_scores(model_test, noise, test.target, yaw,
+                                                         decision.selected_multipliers),
                              "noise": {"x_mm": 1e3 * float(decision.noise[0]), "y_mm": 1e3 * float(decision.noise[1]),
                                        "rotation_deg": float(np.degrees(decision.noise[2]))}},
-                "fallback": metrics.predictive_scores(fallback_mean, fallback_std, test.target, yaw),
+                "fallback": metrics.predictive_scores(fallback_mean, fallback_std, test.target, yaw,
+                                                      decision.fallback_multipliers),
             },
         }
         details = {

@@ -48,7 +48,8 @@ def test_report_follows_the_schema(loop_report):
     report, workdir = loop_report("com_offset")
     assert json.loads((workdir / "report.json").read_text()) == report
     assert set(report) == {"n_pushes", "baseline", "diagnosis", "ranking", "selected", "after", "noise_floor",
-                           "pusher_friction", "explained", "fallback", "remaining", "uncertainty"}
+                           "pusher_friction", "explained", "fallback", "remaining", "uncertainty", "per_group"}
+    assert report["per_group"] == []  # one object on one surface: no groups to fit apart
     friction = report["pusher_friction"]
     assert set(friction) == {"nominal", "force_sensor", "from_force_sensor", "used"}
     assert set(friction["force_sensor"]) == {"value", "std", "n_sequences", "n_pushes", "n_pushes_without", "measured"}
@@ -65,6 +66,9 @@ def test_report_follows_the_schema(loop_report):
     for model in ("selected", "fallback"):
         scores = report["uncertainty"][model]
         assert np.isfinite(scores["nlpd"]) and 0 < scores["coverage_68"] < scores["coverage_95"] <= 1
+        # Split-conformal intervals from the select split hold their level on the test split.
+        assert abs(scores["calibrated_coverage_68"] - 0.68) < 0.05, scores
+        assert abs(scores["calibrated_coverage_95"] - 0.95) < 0.05, scores
     strengths = [entry["strength"] for entry in report["diagnosis"]]
     assert strengths == sorted(strengths, reverse=True)
     assert all(set(entry) == {"variable", "strength"} for entry in report["diagnosis"])
