@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+from collections.abc import Sequence
 
 import numpy as np
 from scipy import stats
@@ -245,7 +246,83 @@ def noise_floor(target: np.ndarray, sequence: np.ndarray, push: np.ndarray, wind
                       n_windows=int(keep.sum()))
 
 
-def predictive_scores(mean: np.ndarray, std: np.ndarray, target: np.ndarray, yaw: np.ndarray) -> dict[str, float]:
+@dataclasses.dataclass(frozen=True)
+class RandomEffects:
+    """One value estimated on several groups, as a random-effects meta-analysis sees it (DerSimonian-Laird).
+
+    Attributes:
+      fixed_mean: the inverse-variance weighted mean (one shared value, no spread between groups).
+      q: Cochran's Q of the groups about ``fixed_mean``.
+      p_value: Q against chi-square with groups - 1 degrees of freedom (small: the groups differ beyond their errors).
+      tau: the between-group standard deviation.
+      mean, mean_std: the shared value (weights ``1 / (std^2 + tau^2)``) and its standard error.
+      shrunk: [G] each group's value shrunk towards ``mean`` by ``tau^2 / (tau^2 + std^2)`` (empirical Bayes).
+      shrunk_std: [G] their standard errors (the share of each group's own error that shrinkage keeps).
+    """
+
+    fixed_mean: float
+    q: float
+    p_value: float
+    tau: float
+    mean: float
+    mean_std: float
+    shrunk: np.ndarray
+    shrunk_std: np.ndarray
+
+
+def random_effects(value: np.ndarray, std: np.ndarray) -> RandomEffects:
+    """Pools [G] group estimates with [G] standard errors (all > 0, G >= 2); see :class:`RandomEffects`."""
+    value, variance = np.asarray(value, np.float64), np.asarray(std, np.float64) ** 2
+    weight = 1.0 / variance
+    fixed_mean = float(np.sum(weight * value) / np.sum(weight))
+    q = float(np.sum(weight * (value - fixed_mean) ** 2))
+    tau_squared = max(0.0, (q - (len(value) - 1)) / (np.sum(weight) - np.sum(weight ** 2) / np.sum(weight)))
+    random_weight = 1.0 / (variance + tau_squared)
+    mean = float(np.sum(random_weight * value) / np.sum(random_weight))
+    keep = tau_squared / (tau_squared + variance)
+    return RandomEffects(fixed_mean=fixed_mean, q=q, p_value=float(stats.chi2.sf(q, len(value) - 1)),
+                         tau=float(np.sqrt(tau_squared)), mean=mean, mean_std=float(np.sqrt(1.0 / np.sum(random_weight))),
+                         shrunk=mean + keep * (value - mean), shrunk_std=np.sqrt(keep * variance))
+
+
+COVERAGE_LEVELS = (0.68, 0.95)
+"""Central interval levels whose coverage the report gives (``coverage_68``, ``coverage_95``)."""
+
+
+def standardised_residuals(mean: np.ndarray, std: np.ndarray, target: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+    """[N, 3] residuals along the object's axes and of the rotation over their predicted standard deviations.
+
+    Args:
+      mean: [N, 3] predicted means, world axes (m, m, rad).
+      std: [N, 3] predicted standard deviations along the object's axes and of the rotation (m, m, rad).
+      target: [N, 3] measured motions, world axes.
+      yaw: [N] object orientation, rad (the axes of ``std``).
+    """
+    residual = np.asarray(target, np.float64) - np.asarray(mean, np.float64)
+    local = np.column_stack([planar.rotate(residual[:, :2], -np.asarray(yaw, np.float64)), residual[:, 2]])
+    return local / np.asarray(std, np.float64)
+
+
+def interval_multipliers(z: np.ndarray, levels: Sequence[float] = COVERAGE_LEVELS) -> np.ndarray:
+    """Split-conformal interval half-widths in units of the predicted standard deviation.
+
+    Args:
+      z: [N, 3] standardised residuals on calibration windows that chose nothing else about the model
+        (:func:`standardised_residuals`; in the loop: out of fold on the select split).
+      levels: central interval levels.
+
+    Returns:
+      [L, 3] per level and output, the ``ceil((N + 1) level) / N`` empirical quantile of ``|z|``: an interval
+      ``mean ± multiplier * std`` then covers at least ``level`` of exchangeable new windows.
+    """
+    magnitude = np.abs(np.asarray(z, np.float64))
+    count = len(magnitude)
+    return np.stack([np.quantile(magnitude, min(1.0, np.ceil((count + 1) * level) / count), axis=0, method="higher")
+                     for level in levels])
+
+
+def predictive_scores(mean: np.ndarray, std: np.ndarray, target: np.ndarray, yaw: np.ndarray,
+                      multipliers: np.ndarray | None = None) -> dict[str, float]:
     """Scores of Gaussian predictive distributions on [N, 3] targets (dx m, dy m, dtheta rad).
 
     Args:
@@ -254,16 +331,22 @@ def predictive_scores(mean: np.ndarray, std: np.ndarray, target: np.ndarray, yaw
         the three outputs are independent.
       target: [N, 3] measured motions, world axes.
       yaw: [N] object orientation, rad (the axes of ``std``).
+      multipliers: [L, 3] calibrated half-widths of the :data:`COVERAGE_LEVELS` intervals
+        (:func:`interval_multipliers`), or None.
 
     Returns:
       {"nlpd": mean negative log predictive density per window (translation in mm, rotation in deg),
-      "coverage_68", "coverage_95": shares of the outputs inside their central 68 % and 95 % intervals}.
+      "coverage_68", "coverage_95": shares of the outputs inside their central 68 % and 95 % Gaussian intervals,
+      and with ``multipliers`` "calibrated_coverage_68", "calibrated_coverage_95": the same for the calibrated
+      intervals}.
     """
-    residual = np.asarray(target, np.float64) - np.asarray(mean, np.float64)
-    local = np.column_stack([planar.rotate(residual[:, :2], -np.asarray(yaw, np.float64)), residual[:, 2]])
+    z = standardised_residuals(mean, std, target, yaw)
     units = np.array([1e3, 1e3, np.degrees(1.0)])
-    z = local / np.asarray(std, np.float64)
     log_density = stats.norm.logpdf(z) - np.log(np.asarray(std, np.float64) * units)
-    return {"nlpd": float(-np.mean(log_density.sum(axis=1))),
-            "coverage_68": float(np.mean(np.abs(z) <= stats.norm.ppf(0.84))),
-            "coverage_95": float(np.mean(np.abs(z) <= stats.norm.ppf(0.975)))}
+    scores = {"nlpd": float(-np.mean(log_density.sum(axis=1)))}
+    for level in COVERAGE_LEVELS:
+        scores[f"coverage_{round(100 * level)}"] = float(np.mean(np.abs(z) <= stats.norm.ppf(0.5 + level / 2)))
+    if multipliers is not None:
+        for level, half_width in zip(COVERAGE_LEVELS, multipliers):
+            scores[f"calibrated_coverage_{round(100 * level)}"] = float(np.mean(np.abs(z) <= half_width))
+    return scores

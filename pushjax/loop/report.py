@@ -230,7 +230,9 @@ class LoopDetails:
             "rounds": [{"gains": dict(zip(r.additions, r.gains)), "p_values": dict(zip(r.additions, r.p_values)),
                         "levels": dict(zip(r.additions, r.levels)),
                         "beyond_noise": dict(zip(r.additions, r.beyond_noise)), "floor": r.floor,
-                        "mechanism": [dataclasses.asdict(check) for check in r.mechanism],
+                        "mechanism": [{**dataclasses.asdict(check), "p_value": check.p_value,
+                                       "variable": check.variable, "knob": check.is_knob(self.alpha)}
+                                      for check in r.mechanism],
                         "accepted": r.accepted} for r in self.rounds],
             "fallback_select": {"gain": self.fallback_gain, "p_value": self.fallback_p_value,
                                 "beyond_noise": self.fallback_beyond_noise},
@@ -411,9 +413,13 @@ def markdown(result: LoopResult) -> str:
                      f"{round_.gains[index]:+.3f}, p = {round_.p_values[index]:.2g} (Holm level "
                      f"{round_.levels[index]:.2g}); candidates beyond noise: {', '.join(passed) or 'none'}")
         for check in round_.mechanism:
-            verdict = ("not testable here (one group, or too few sequences per group)" if check.p_value is None
-                       else f"p = {check.p_value:.2g} for agreement across {check.variable}: "
-                       + ("**a knob, not a mechanism**" if check.is_knob(details.alpha) else "a mechanism"))
+            if check.p_value is None:
+                verdict = "not testable here (one group, or too few sequences per group)"
+            else:
+                worst = check.tests[0]
+                verdict = (f"p = {worst.p_value:.2g} for agreement of {worst.value} across {worst.variable}, "
+                           f"between-group spread {worst.relative_spread:.2f} of the effect's size: "
+                           + ("**a knob, not a mechanism**" if check.is_knob(details.alpha) else "a mechanism"))
             lines.append(f"   - mechanism check of `{check.effect}`: {verdict}")
     if report.selected:
         lines += ["", "Fitted parameters of the selected model (every pool push):", ""]

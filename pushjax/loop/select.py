@@ -16,7 +16,8 @@ subsumes ``friction_ratio`` and ``pressure_gradient``, replaces them) and tests 
 
 * a mechanism, not a knob (:func:`check_mechanism`): the added effect's parameters, fitted separately on the pool
   sequences of each object, surface or push velocity (where the data has several with enough sequences), agree
-  within their standard errors (Cochran's Q). Parameters that belong to one object (a pressure, a marker, a hidden
+  within their standard errors (Cochran's Q) or, where they do not, spread between groups by at most
+  :data:`MECHANISM_SPREAD` of the effect's size (a practical margin). Parameters that belong to one object (a pressure, a marker, a hidden
   weight: ``Effect.per_object``) are compared across surfaces and velocities only.
 
 Among the candidates that pass, the one with the largest gain is added; selection stops when none passes.
@@ -29,10 +30,9 @@ import dataclasses
 from collections.abc import Callable, Sequence
 
 import numpy as np
-from scipy import stats
 
 from pushjax.loop import fit as fit_lib
-from pushjax.loop import metrics
+from pushjax.loop import hierarchy, metrics
 from pushjax.loop.splits import Split
 from pushjax.loop.windows import Examples
 from pushjax.physics.effects import EFFECT_NAMES, EFFECTS
@@ -66,8 +66,37 @@ class Candidate:
 
 MECHANISM_GROUPS = ("object", "surface", "push velocity")
 """Variables whose values split the pool into groups on which an added effect's parameters must agree."""
-MIN_GROUP_SEQUENCES = 8
-"""Fewest pool sequences of a group for :func:`check_mechanism` to fit the effect on it."""
+MECHANISM_SPREAD = 0.5
+"""Largest between-group spread of a value, over the effect's size, that still counts as one mechanism.
+
+Fixed before the power / false-discovery table of issue 29 was measured. The spread is the random-effects standard
+deviation between groups (DerSimonian-Laird); the size is the largest distance of the effect's values in the same unit
+from their "no effect" values (offsets x and y share one size), and a direction (a value in degrees) counts a size of
+90 degrees. With many pushes the groups' standard errors shrink below the misfit that any simulator leaves, so
+"agree within their standard errors" alone rejects a true centre-of-mass offset whose groups agree within 1-3 mm
+(BENCHMARKS.md, 500 pushes); a knob's groups differ by as much as the effect itself."""
+DIRECTION_SIZE_DEG = 90.0
+"""The size a direction (a value in degrees) is compared with: its spread may reach ``MECHANISM_SPREAD`` of it."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Heterogeneity:
+    """Whether one reported value of an effect agrees across the groups of one variable.
+
+    Attributes:
+      variable: the grouping variable (one of :data:`MECHANISM_GROUPS`).
+      value: the reported value's name (``pushjax.physics.effects``' physical values).
+      p_value: Cochran's Q p-value, Bonferroni-adjusted over the check's tests.
+      relative_spread: the between-group standard deviation over the effect's size (see :data:`MECHANISM_SPREAD`).
+    """
+
+    variable: str
+    value: str
+    p_value: float
+    relative_spread: float
+
+    def is_knob(self, alpha: float) -> bool:
+        return self.p_value <= alpha and self.relative_spread > MECHANISM_SPREAD
 
 
 @dataclasses.dataclass(frozen=True)
@@ -76,19 +105,28 @@ class MechanismCheck:
 
     Attributes:
       effect: the added effect.
-      variable: the grouping variable with the smallest p-value, or None when no grouping could be tested.
-      p_value: Bonferroni-adjusted smallest heterogeneity p-value over the groupings and reported values (None: not
-        testable: one group, or groups with too few sequences).
+      tests: one per grouping variable and reported value, most heterogeneous (smallest p-value) first; empty when no
+        grouping could be tested (one group, or groups with too few sequences).
       values: {grouping variable: {group: {value name: {"value", "std"}}}} of the fits on each group.
     """
 
     effect: str
-    variable: str | None
-    p_value: float | None
+    tests: list[Heterogeneity]
     values: dict[str, dict[str, dict[str, dict]]]
 
+    @property
+    def p_value(self) -> float | None:
+        """The smallest adjusted heterogeneity p-value (None: not testable)."""
+        return self.tests[0].p_value if self.tests else None
+
+    @property
+    def variable(self) -> str | None:
+        """The grouping variable of the smallest p-value (None: not testable)."""
+        return self.tests[0].variable if self.tests else None
+
     def is_knob(self, alpha: float) -> bool:
-        return self.p_value is not None and self.p_value <= alpha
+        """A knob, not a mechanism: some value differs between groups beyond both noise and the practical margin."""
+        return any(test.is_knob(alpha) for test in self.tests)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -249,34 +287,46 @@ def check_mechanism(pool: Examples, effects: tuple[str, ...], added: str, settin
                     initial: dict) -> MechanismCheck:
     """Fits ``effects`` on the pool sequences of each group and tests whether ``added``'s values agree.
 
-    For each variable of :data:`MECHANISM_GROUPS` with at least two groups of :data:`MIN_GROUP_SEQUENCES` sequences
-    (only ``surface`` and ``push velocity`` for a per-object effect), Cochran's Q of each reported value over the groups
-    (inverse-variance weights from the sandwich standard errors) against chi-square with groups - 1 degrees of freedom;
-    the smallest p-value times the number of tests is the check's p-value.
+    For each variable of :data:`MECHANISM_GROUPS` with at least two groups of :data:`pushjax.loop.hierarchy.MIN_GROUP_SEQUENCES` sequences
+    (only ``surface`` and ``push velocity`` for a per-object effect) and each reported value: Cochran's Q over the
+    groups (inverse-variance weights from the sandwich standard errors) against chi-square with groups - 1 degrees of
+    freedom, Bonferroni-adjusted over the check's tests, and the DerSimonian-Laird between-group standard deviation
+    relative to the effect's size (:data:`MECHANISM_SPREAD`). A value is a knob's when both are beyond their bounds.
     """
     variables = [name for name in MECHANISM_GROUPS if not (EFFECTS[added].per_object and name == "object")]
-    values, tests = {}, []
+    neutral = {name: float(value) for name, value in EFFECTS[added].physical(EFFECTS[added].init()).items()}
+    values, raw = {}, []
     for variable in variables:
-        labels = pool.variables[variable]
-        groups = [label for label in np.unique(labels)
-                  if len(np.unique(pool.sequence[labels == label])) >= MIN_GROUP_SEQUENCES]
-        if len(groups) < 2:
+        groups, fits = hierarchy.fit_groups(pool, effects, variable, settings, initial)
+        if not fits:
             continue
-        fits = [fit_lib.fit_effects([effects], pool.select(labels == label), settings, initial=[initial])[0]
-                for label in groups]
-        values[variable] = {str(label): result.physical[added] for label, result in zip(groups, fits)}
+        values[variable] = {label: result.physical[added] for label, result in zip(groups, fits)}
+        pooled = {}
         for name in fits[0].physical[added]:
             estimates = [result.physical[added][name] for result in fits]
             if any(estimate["std"] is None or not estimate["std"] > 0 for estimate in estimates):
                 continue
-            value = np.array([estimate["value"] for estimate in estimates])
-            weight = 1.0 / np.array([estimate["std"] for estimate in estimates]) ** 2
-            q = float(np.sum(weight * (value - np.sum(weight * value) / np.sum(weight)) ** 2))
-            tests.append((float(stats.chi2.sf(q, len(groups) - 1)), variable))
-    if not tests:
-        return MechanismCheck(effect=added, variable=None, p_value=None, values=values)
-    p_value, variable = min(tests)
-    return MechanismCheck(effect=added, variable=variable, p_value=min(1.0, p_value * len(tests)), values=values)
+            pooled[name] = metrics.random_effects([estimate["value"] for estimate in estimates],
+                                                  [estimate["std"] for estimate in estimates])
+        centres = {name: result.fixed_mean for name, result in pooled.items()}
+        for name, result in pooled.items():
+            raw.append((result.p_value, variable, name,
+                        result.tau / max(_effect_size(name, centres, neutral), np.finfo(float).tiny)))
+    tests = [Heterogeneity(variable=variable, value=name, p_value=min(1.0, p_value * len(raw)),
+                           relative_spread=relative)
+             for p_value, variable, name, relative in sorted(raw, key=lambda test: test[0])]
+    return MechanismCheck(effect=added, tests=tests, values=values)
+
+
+def _unit(name: str) -> str:
+    return name.rsplit("_", 1)[-1]
+
+
+def _effect_size(name: str, pooled: dict[str, float], neutral: dict[str, float]) -> float:
+    """The size ``name``'s spread is compared with: the largest distance from "no effect" of the values in its unit."""
+    if _unit(name) == "deg":
+        return DIRECTION_SIZE_DEG
+    return max(abs(pooled[other] - neutral[other]) for other in pooled if _unit(other) == _unit(name))
 
 
 def _next_sets(current: tuple[str, ...], effects: Sequence[str]) -> tuple[list[tuple[str, ...]], list[str]]:

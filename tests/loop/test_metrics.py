@@ -34,6 +34,41 @@ def test_predictive_scores_of_a_calibrated_gaussian():
     assert too_narrow["nlpd"] > scores["nlpd"] and too_narrow["coverage_95"] < 0.9
 
 
+def test_conformal_multipliers_restore_the_coverage_of_a_misspecified_distribution():
+    # Heavy-tailed residuals (Student t, 3 degrees of freedom) under a standard deviation 0.7 of their scale: the
+    # Gaussian intervals miss; the multipliers from one half make the other half's intervals reach their level.
+    rng = np.random.default_rng(1)
+    count = 40000
+    std = np.column_stack([np.full(count, 1e-3), np.full(count, 1e-3), np.full(count, 1e-2)])
+    yaw = rng.uniform(-np.pi, np.pi, count)
+    local = rng.standard_t(3, size=(count, 3)) * std / 0.7
+    world = np.column_stack([np.cos(yaw) * local[:, 0] - np.sin(yaw) * local[:, 1],
+                             np.sin(yaw) * local[:, 0] + np.cos(yaw) * local[:, 1], local[:, 2]])
+    half = count // 2
+    z = metrics.standardised_residuals(np.zeros((half, 3)), std[:half], world[:half], yaw[:half])
+    np.testing.assert_allclose(z, local[:half] / std[:half], rtol=1e-9)
+    multipliers = metrics.interval_multipliers(z)
+    assert multipliers.shape == (2, 3) and np.all(multipliers[1] > multipliers[0])
+    scores = metrics.predictive_scores(np.zeros((half, 3)), std[half:], world[half:], yaw[half:], multipliers)
+    assert abs(scores["coverage_68"] - 0.68) > 0.05 or abs(scores["coverage_95"] - 0.95) > 0.05, scores
+    assert abs(scores["calibrated_coverage_68"] - 0.68) < 0.01, scores
+    assert abs(scores["calibrated_coverage_95"] - 0.95) < 0.01, scores
+
+
+def test_random_effects_pool_agreeing_groups_and_shrink_an_imprecise_one():
+    agreeing = metrics.random_effects([1.0, 1.02, 0.98], [0.1, 0.1, 0.1])
+    assert agreeing.tau == 0.0 and agreeing.p_value > 0.5
+    np.testing.assert_allclose(agreeing.shrunk, agreeing.mean)
+    np.testing.assert_allclose(agreeing.mean, 1.0)
+    # Two precise groups that differ (a real spread) and one imprecise group far out: the precise ones keep their
+    # values, the imprecise one is pulled most of the way to the shared value.
+    spread = metrics.random_effects([1.0, 2.0, 5.0], [0.01, 0.01, 3.0])
+    assert spread.p_value < 1e-6 and 0.5 < spread.tau < 1.0
+    np.testing.assert_allclose(spread.shrunk[:2], [1.0, 2.0], atol=1e-3)
+    assert abs(spread.shrunk[2] - spread.mean) < 0.2 * abs(5.0 - spread.mean)
+    assert np.all(spread.shrunk_std <= np.array([0.01, 0.01, 3.0]))
+
+
 def test_holm_steps_down_from_the_smallest_p_value():
     rejected, levels = metrics.holm(np.array([0.04, 0.001, 0.015, 0.3]), alpha=0.05)
     np.testing.assert_allclose(levels, [0.05 / 2, 0.05 / 4, 0.05 / 3, 0.05])

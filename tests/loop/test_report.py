@@ -13,7 +13,7 @@ from pushjax.loop import report as report_lib
 from pushjax.loop.diagnose import Dependence
 from pushjax.loop.force import ForceFriction
 from pushjax.loop.metrics import NoiseFloor
-from pushjax.loop.select import MechanismCheck, Round
+from pushjax.loop.select import Heterogeneity, MechanismCheck, Round
 
 EXPECTED = Path(__file__).parent / "report_small"
 
@@ -43,8 +43,10 @@ def small_result(measured_friction: bool) -> report_lib.LoopResult:
     rounds = [
         Round(candidates=[], additions=["cof_offset", "table_tilt"], gains=[0.375, 0.0625], p_values=[0.0001, 0.25],
               levels=[0.025, 0.05], beyond_noise=[True, False], floor=1.5,
-              mechanism=[MechanismCheck("cof_offset", "surface", 0.5, {}), MechanismCheck("cof_offset", "object", 0.01, {}),
-                         MechanismCheck("cof_offset", None, None, {})],
+              mechanism=[MechanismCheck("cof_offset", [Heterogeneity("surface", "offset_x_mm", 0.5, 0.75)], {}),
+                         MechanismCheck("cof_offset", [Heterogeneity("object", "offset_y_mm", 0.01, 0.625),
+                                                       Heterogeneity("surface", "offset_x_mm", 0.5, 0.25)], {}),
+                         MechanismCheck("cof_offset", [], {})],
               accepted="cof_offset"),
         Round(candidates=[], additions=["table_tilt"], gains=[-0.125], p_values=[0.75], levels=[0.05],
               beyond_noise=[False], floor=0.75, mechanism=[], accepted=None),
