@@ -48,7 +48,7 @@ def main():
         print(f"recorded {len(recorded.written)} pushes ({len(recorded.skipped)} reused) in "
               f"{time.perf_counter() - start:.1f} s")
         start, cpu = time.perf_counter(), _cpu_seconds()
-        report = close_loop(data_dir, workdir, seed=args.seed)
+        report = close_loop(data_dir, workdir, seed=args.seed).report.as_dict()
         elapsed, cpu = time.perf_counter() - start, _cpu_seconds() - cpu
     pushes = len(recorded.written) + len(recorded.skipped)
     print(json.dumps({key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "noise_floor", "explained")},

@@ -59,7 +59,7 @@ def main(argv):
                             min_strength=_MIN_STRENGTH.value, effects=tuple(_EFFECTS.value),
                             fit=dataclasses.replace(FitSettings(), steps=_STEPS.value))
     try:
-        report = close_loop(_DATA_DIR.value, _WORKDIR.value, settings, seed=_SEED.value)
+        report = close_loop(_DATA_DIR.value, _WORKDIR.value, settings, seed=_SEED.value).report.as_dict()
     except ValueError as error:
         message = str(error)
         if message.startswith("data_dir"):

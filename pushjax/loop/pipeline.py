@@ -175,17 +175,13 @@ def with_pusher_friction(examples: Examples, mu: float) -> Examples:
     return dataclasses.replace(examples, inputs=examples.inputs.replace(mu=np.full(len(examples), float(mu))))
 
 
-def _dependences(dependences: list[diagnose_lib.Dependence]) -> list[dict]:
-    return [dataclasses.asdict(d) for d in dependences]
-
-
 def close_loop(
     data_dir: str | os.PathLike,
     workdir: str | os.PathLike,
     settings: LoopSettings = LoopSettings(),
     seed: int = 0,
     progress: bool = True,
-) -> dict:
+) -> report_lib.LoopResult:
     """Runs the loop and writes ``report.json``, ``details.json``, ``report.md`` and figures to ``workdir``.
 
     Args:
@@ -196,7 +192,7 @@ def close_loop(
       progress: show tqdm progress bars.
 
     Returns:
-      The content of ``report.json``.
+      What the loop found (the content of ``report.json``) and how it decided (``details.json``).
 
     Raises:
       ValueError: ``data_dir`` is not a directory, holds no usable push, or too few push sequences to
@@ -242,77 +238,64 @@ def close_loop(
         plain_test, model_test = fit_lib.predict([None, model], test)
         fallback_mean, fallback_std = term(test, model_test)
 
-        def measured(prediction):
+        def measured(prediction) -> report_lib.HeldOutErrors:
             errors = metrics.window_errors(prediction, test.target, test.sequence)
-            return {**report_lib.as_summary(metrics.summarize(errors)),
-                    "interval": metrics.bootstrap_interval(errors, settings.n_bootstrap, seed)}
+            return report_lib.HeldOutErrors.from_summary(
+                metrics.summarize(errors), interval=metrics.bootstrap_interval(errors, settings.n_bootstrap, seed))
 
         yaw = np.asarray(test.inputs.object_yaw, np.float64)
         noise = np.broadcast_to(decision.noise, model_test.shape)
-        floor = metrics.noise_floor(test.target, test.sequence, test.push, test.window, test.tracking_noise,
-                                    settings.n_bootstrap, seed)
-        after = measured(model_test)
-        above = {key: after[key] - getattr(floor, key) for key in ("trans_percent", "rot_percent")}
-        explained = all(after[key] <= floor.interval[key][1] for key in above)
+        report = report_lib.LoopReport(
+            n_pushes={**split.n_pushes(), "skipped": int(n_skipped)},
+            baseline=measured(plain_test),
+            diagnosis=decision.diagnosis_before,
+            ranking=[report_lib.RankedEffect(effect=c.effects[0], params=c.fits[0].physical[c.effects[0]],
+                                             select=report_lib.Errors.from_summary(c.summary))
+                     for c in selection.ranking],
+            selected=selection.selected,
+            after=measured(model_test),
+            noise_floor=metrics.noise_floor(test.target, test.sequence, test.push, test.window, test.tracking_noise,
+                                            settings.n_bootstrap, seed),
+            pusher_friction=report_lib.PusherFriction(
+                nominal=settings.pusher_friction, force_sensor=decision.force,
+                from_force_sensor=settings.measure_pusher_friction and decision.force.measured,
+                used=float(pool.inputs.mu[0])),
+            fallback=measured(fallback_mean),
+            remaining=decision.remaining,
+            uncertainty=report_lib.Uncertainty(
+                selected=metrics.predictive_scores(model_test, noise, test.target, yaw, decision.selected_multipliers),
+                noise=decision.noise,
+                fallback=metrics.predictive_scores(fallback_mean, fallback_std, test.target, yaw,
+                                                   decision.fallback_multipliers)),
+            per_group=per_group,
+        )
         stages.update()
 
         stage("writing the report")
-        report = {
-            "n_pushes": {**split.n_pushes(), "skipped": int(n_skipped)},
-            "baseline": measured(plain_test),
-            "diagnosis": [{"variable": d.variable, "strength": d.strength} for d in decision.diagnosis_before],
-            "ranking": [{"effect": c.effects[0], "params": c.fits[0].physical[c.effects[0]],
-                         "select": report_lib.as_summary(c.summary)} for c in selection.ranking],
-            "selected": selection.selected,
-            "after": after,
-            "noise_floor": floor.as_dict(),
-            "pusher_friction": {"nominal": settings.pusher_friction, "force_sensor": decision.force.as_dict(),
-                                "from_force_sensor": settings.measure_pusher_friction and decision.force.measured,
-                                "used": float(pool.inputs.mu[0])},
-            "explained": explained,
-            "per_group": [dataclasses.asdict(values) for values in per_group],
-            "fallback": measured(fallback_mean),
-            "remaining": {"above_floor": above,
-                          "variables": [{"variable": d.variable, "strength": d.strength} for d in decision.remaining]},
-            "uncertainty": {
-                "selected": {**metrics.predictive_scores(model_test, noise, test.target, yaw,
-                                                         decision.selected_multipliers),
-                             "noise": {"x_mm": 1e3 * float(decision.noise[0]), "y_mm": 1e3 * float(decision.noise[1]),
-                                       "rotation_deg": float(np.degrees(decision.noise[2]))}},
-                "fallback": metrics.predictive_scores(fallback_mean, fallback_std, test.target, yaw,
-                                                      decision.fallback_multipliers),
-            },
-        }
-        details = {
-            "data_dir": str(data_dir),
-            "horizon": settings.horizon,
-            "seed": seed,
-            "pusher_friction": settings.pusher_friction,
-            "alpha": settings.alpha,
-            "min_gain": settings.min_gain,
-            "cross_fitted": split.cross_fitted,
-            "n_sequences": {"pool": pool.n_sequences, "test": test.n_sequences},
-            "n_windows": {"fit": len(split.folds[0][0]), "select": len(split.select_index), "test": len(test)},
-            "skipped": {**{reason: [p.name for p in paths] for reason, paths in pushes.skipped.items()},
-                        **build.skipped},
-            "diagnosis_before": _dependences(decision.diagnosis_before),
-            "diagnosis_after": _dependences(decision.diagnosis_after),
-            "select_noise_floor": selection.noise_floor.as_dict(),
-            "rounds": [{"gains": dict(zip(r.additions, r.gains)), "p_values": dict(zip(r.additions, r.p_values)),
-                        "levels": dict(zip(r.additions, r.levels)),
-                        "beyond_noise": dict(zip(r.additions, r.beyond_noise)), "floor": r.floor,
-                        "mechanism": [{**dataclasses.asdict(check), "p_value": check.p_value,
-                                       "variable": check.variable, "knob": check.is_knob(settings.alpha)}
-                                      for check in r.mechanism],
-                        "accepted": r.accepted} for r in selection.rounds],
-            "fallback_select": {"gain": decision.fallback_gain, "p_value": decision.fallback_p_value,
-                                "beyond_noise": decision.fallback_helps},
-            "selected_params": model.physical if model is not None else {},
-        }
-        (workdir / report_lib.FIGURE_DIR).mkdir(parents=True, exist_ok=True)
-        report_lib.write_json(workdir / "report.json", report)
-        report_lib.write_json(workdir / "details.json", details)
+        details = report_lib.LoopDetails(
+            data_dir=str(data_dir),
+            horizon=settings.horizon,
+            seed=seed,
+            pusher_friction=settings.pusher_friction,
+            alpha=settings.alpha,
+            min_gain=settings.min_gain,
+            cross_fitted=split.cross_fitted,
+            n_sequences={"pool": pool.n_sequences, "test": test.n_sequences},
+            n_windows={"fit": len(split.folds[0][0]), "select": len(split.select_index), "test": len(test)},
+            skipped={**{reason: [p.name for p in paths] for reason, paths in pushes.skipped.items()}, **build.skipped},
+            diagnosis_before=decision.diagnosis_before,
+            diagnosis_after=decision.diagnosis_after,
+            select_noise_floor=selection.noise_floor,
+            rounds=selection.rounds,
+            fallback_gain=decision.fallback_gain,
+            fallback_p_value=decision.fallback_p_value,
+            fallback_beyond_noise=decision.fallback_helps,
+            selected_params=model.physical if model is not None else {},
+        )
+        result = report_lib.LoopResult(report=report, details=details)
         figures = workdir / report_lib.FIGURE_DIR
+        figures.mkdir(parents=True, exist_ok=True)
+        report_lib.write(workdir, result)
         selection_windows = pool.select(split.select_index)
         report_lib.residual_figure(figures / "residual_baseline.png", selection_windows, selection.baseline.prediction,
                                    "Residual of the plain model (median per bin)", decision.variables)
@@ -320,6 +303,5 @@ def close_loop(
                                    "Residual after the fix: " + (" + ".join(selection.selected) or "nothing selected"),
                                    decision.variables)
         report_lib.strength_figure(figures / "diagnosis.png", decision.diagnosis_before, decision.diagnosis_after)
-        (workdir / "report.md").write_text(report_lib.markdown(report, details))
         stages.update()
-    return report
+    return result

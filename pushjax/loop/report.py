@@ -1,8 +1,9 @@
-"""Writing the loop's results: ``report.json`` (the issue's schema), ``details.json``, ``report.md`` and
-figures of the residual against the candidate variables."""
+"""The loop's results as types, and writing them: ``report.json`` (the issue's schema), ``details.json``,
+``report.md`` and figures of the residual against the candidate variables."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -11,10 +12,256 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from pushjax.loop import diagnose as diagnose_lib
-from pushjax.loop.metrics import METRIC_KEYS
+from pushjax.loop import force as force_lib
+from pushjax.loop import hierarchy
+from pushjax.loop import metrics
+from pushjax.loop import select as select_lib
 from pushjax.loop.windows import CATEGORICAL, VARIABLES, Examples
 
 FIGURE_DIR = "figures"
+
+
+@dataclasses.dataclass(frozen=True)
+class Errors:
+    """A model's mean errors on a set of windows.
+
+    Attributes:
+      trans_percent, rot_percent: translation and rotation error in % of the ``zero`` baseline's on the same windows.
+      trans_mm, rot_deg: mean translation (mm) and rotation (deg) error per window.
+    """
+
+    trans_percent: float
+    rot_percent: float
+    trans_mm: float
+    rot_deg: float
+
+    @classmethod
+    def from_summary(cls, summary: dict, **fields):
+        """From :func:`pushjax.loop.metrics.summarize`'s dict (values as plain floats) and a subclass's ``fields``."""
+        return cls(**{key: float(summary[key]) for key in metrics.METRIC_KEYS}, **fields)
+
+    @property
+    def combined(self) -> float:
+        return self.trans_percent + self.rot_percent
+
+
+@dataclasses.dataclass(frozen=True)
+class HeldOutErrors(Errors):
+    """A model's mean errors on the test split and their uncertainty.
+
+    Attributes:
+      interval: {metric: [low, high]} 95 % bootstrap interval over test push sequences, per :class:`Errors` field.
+    """
+
+    interval: dict[str, list[float]]
+
+
+@dataclasses.dataclass(frozen=True)
+class RankedEffect:
+    """One library effect fitted alone, as ranked on the select split.
+
+    Attributes:
+      effect: the effect's name.
+      params: {value name: {"value": float, "std": float or None}} its fitted physical values (first fold).
+      select: its out-of-fold errors on the selection windows.
+    """
+
+    effect: str
+    params: dict[str, dict[str, float | None]]
+    select: Errors
+
+
+@dataclasses.dataclass(frozen=True)
+class PusherFriction:
+    """The pusher–object friction coefficient the models used.
+
+    Attributes:
+      nominal: the coefficient of the settings.
+      force_sensor: what the force sensor read on the pool's sliding pushes.
+      from_force_sensor: whether the models use the measured coefficient instead of the nominal one.
+      used: the coefficient the models use.
+    """
+
+    nominal: float
+    force_sensor: force_lib.ForceFriction
+    from_force_sensor: bool
+    used: float
+
+
+@dataclasses.dataclass(frozen=True)
+class Uncertainty:
+    """Scores of the predictive distributions on the test split (see :func:`pushjax.loop.metrics.predictive_scores`).
+
+    Attributes:
+      selected: scores of the selected model with its fitted noise.
+      noise: [3] that noise: standard deviation along the object's axes and of the rotation (m, m, rad).
+      fallback: scores of the learned error term's mean and variance.
+    """
+
+    selected: dict[str, float]
+    noise: np.ndarray
+    fallback: dict[str, float]
+
+
+@dataclasses.dataclass(frozen=True)
+class LoopReport:
+    """What the loop found (``report.json``).
+
+    Attributes:
+      n_pushes: {"fit", "select", "test", "skipped"} pushes per role (fit: of the first fold) and push files skipped.
+      baseline: the plain Lynch model's test errors.
+      diagnosis: the plain model's residual on the pool against each variable, strongest first.
+      ranking: the single-effect models, best selection score first.
+      selected: the selected effects in the order they were selected.
+      after: the selected model's test errors.
+      noise_floor: the test split's noise floor.
+      pusher_friction: the pusher–object friction coefficient the models used.
+      fallback: the selected model's plus the learned error term's test errors.
+      remaining: the variables the selected model's residual still depends on beyond noise (select split).
+      uncertainty: how sure the selected model and the learned error term are.
+      per_group: the selected model's values per object and per surface, shrunk to a shared value (empty when
+        nothing is selected or the pool has one object and one surface).
+    """
+
+    n_pushes: dict[str, int]
+    baseline: HeldOutErrors
+    diagnosis: list[diagnose_lib.Dependence]
+    ranking: list[RankedEffect]
+    selected: list[str]
+    after: HeldOutErrors
+    noise_floor: metrics.NoiseFloor
+    pusher_friction: PusherFriction
+    fallback: HeldOutErrors
+    remaining: list[diagnose_lib.Dependence]
+    uncertainty: Uncertainty
+    per_group: list[hierarchy.GroupValues]
+
+    @property
+    def above_floor(self) -> dict[str, float]:
+        """{"trans_percent", "rot_percent"}: the selected model's test error above the noise floor, points of %."""
+        return {key: getattr(self.after, key) - getattr(self.noise_floor, key) for key in ("trans_percent", "rot_percent")}
+
+    @property
+    def explained(self) -> bool:
+        """Whether the selected model's test error is within the noise floor's interval."""
+        return all(getattr(self.after, key) <= self.noise_floor.interval[key][1] for key in self.above_floor)
+
+    def as_dict(self) -> dict:
+        """The content of ``report.json``."""
+        return {
+            "n_pushes": self.n_pushes,
+            "baseline": dataclasses.asdict(self.baseline),
+            "diagnosis": _strengths(self.diagnosis),
+            "ranking": [dataclasses.asdict(entry) for entry in self.ranking],
+            "selected": self.selected,
+            "after": dataclasses.asdict(self.after),
+            "noise_floor": self.noise_floor.as_dict(),
+            "pusher_friction": {**dataclasses.asdict(self.pusher_friction),
+                                "force_sensor": self.pusher_friction.force_sensor.as_dict()},
+            "explained": self.explained,
+            "per_group": [dataclasses.asdict(values) for values in self.per_group],
+            "fallback": dataclasses.asdict(self.fallback),
+            "remaining": {"above_floor": self.above_floor, "variables": _strengths(self.remaining)},
+            "uncertainty": {
+                "selected": {**self.uncertainty.selected,
+                             "noise": {"x_mm": 1e3 * float(self.uncertainty.noise[0]),
+                                       "y_mm": 1e3 * float(self.uncertainty.noise[1]),
+                                       "rotation_deg": float(np.degrees(self.uncertainty.noise[2]))}},
+                "fallback": self.uncertainty.fallback,
+            },
+        }
+
+
+@dataclasses.dataclass(frozen=True)
+class LoopDetails:
+    """How the loop decided (``details.json``).
+
+    Attributes:
+      data_dir: root of the pushes.
+      horizon: prediction window, s.
+      seed: seed of the split, the tests, the cross-fitting folds and the error terms.
+      pusher_friction: nominal pusher–object friction coefficient.
+      alpha: family-wise error level of the decisions.
+      min_gain: share of the error above the noise floor that a selected effect had to remove.
+      cross_fitted: whether effects were chosen cross-fitted over sequence folds (else one fit and one select split).
+      n_sequences: {"pool", "test"} push sequences per split.
+      n_windows: {"fit", "select", "test"} windows per role (fit: of the first fold).
+      skipped: {reason: [push file names]} of the push files that gave no window.
+      diagnosis_before: the plain model's residual on the pool against the variables.
+      diagnosis_after: the selected model's out-of-fold residual on the selection windows.
+      select_noise_floor: the noise floor of the selection windows.
+      rounds: the forward-selection rounds.
+      fallback_gain: relative selection-error cut of the learned error term over the selected model.
+      fallback_p_value: its one-sided sign-flip p-value.
+      fallback_beyond_noise: whether the learned error term lowers the selection error beyond noise.
+      selected_params: {effect: {value name: {"value", "std"}}} of the selected model refitted on the pool.
+    """
+
+    data_dir: str
+    horizon: float
+    seed: int
+    pusher_friction: float
+    alpha: float
+    min_gain: float
+    cross_fitted: bool
+    n_sequences: dict[str, int]
+    n_windows: dict[str, int]
+    skipped: dict[str, list[str]]
+    diagnosis_before: list[diagnose_lib.Dependence]
+    diagnosis_after: list[diagnose_lib.Dependence]
+    select_noise_floor: metrics.NoiseFloor
+    rounds: list[select_lib.Round]
+    fallback_gain: float
+    fallback_p_value: float
+    fallback_beyond_noise: bool
+    selected_params: dict[str, dict[str, dict[str, float | None]]]
+
+    def as_dict(self) -> dict:
+        """The content of ``details.json``."""
+        return {
+            "data_dir": self.data_dir,
+            "horizon": self.horizon,
+            "seed": self.seed,
+            "pusher_friction": self.pusher_friction,
+            "alpha": self.alpha,
+            "min_gain": self.min_gain,
+            "cross_fitted": self.cross_fitted,
+            "n_sequences": self.n_sequences,
+            "n_windows": self.n_windows,
+            "skipped": self.skipped,
+            "diagnosis_before": [dataclasses.asdict(d) for d in self.diagnosis_before],
+            "diagnosis_after": [dataclasses.asdict(d) for d in self.diagnosis_after],
+            "select_noise_floor": self.select_noise_floor.as_dict(),
+            "rounds": [{"gains": dict(zip(r.additions, r.gains)), "p_values": dict(zip(r.additions, r.p_values)),
+                        "levels": dict(zip(r.additions, r.levels)),
+                        "beyond_noise": dict(zip(r.additions, r.beyond_noise)), "floor": r.floor,
+                        "mechanism": [{**dataclasses.asdict(check), "p_value": check.p_value,
+                                       "variable": check.variable, "knob": check.is_knob(self.alpha)}
+                                      for check in r.mechanism],
+                        "accepted": r.accepted} for r in self.rounds],
+            "fallback_select": {"gain": self.fallback_gain, "p_value": self.fallback_p_value,
+                                "beyond_noise": self.fallback_beyond_noise},
+            "selected_params": self.selected_params,
+        }
+
+
+@dataclasses.dataclass(frozen=True)
+class LoopResult:
+    """What :func:`pushjax.loop.pipeline.close_loop` found and how it decided."""
+
+    report: LoopReport
+    details: LoopDetails
+
+
+def _strengths(dependences: list[diagnose_lib.Dependence]) -> list[dict]:
+    return [{"variable": d.variable, "strength": d.strength} for d in dependences]
+
+
+def write(workdir: Path, result: LoopResult) -> None:
+    """Writes ``report.json``, ``details.json`` and ``report.md`` to ``workdir`` (which exists)."""
+    write_json(workdir / "report.json", result.report.as_dict())
+    write_json(workdir / "details.json", result.details.as_dict())
+    (workdir / "report.md").write_text(markdown(result))
 
 
 def write_json(path: Path, value) -> None:
@@ -75,10 +322,12 @@ def strength_figure(path: Path, before: list, after: list) -> None:
     plt.close(figure)
 
 
-def _metrics_row(label: str, summary: dict) -> str:
-    low, high = (sum(bound) for bound in zip(summary["interval"]["trans_percent"], summary["interval"]["rot_percent"]))
-    return (f"| {label} | {summary['trans_percent']:.1f} | {summary['rot_percent']:.1f} | {summary['trans_mm']:.3f} "
-            f"| {summary['rot_deg']:.3f} | {summary['trans_percent'] + summary['rot_percent']:.1f} ({low:.1f}–{high:.1f}) |")
+
+
+def _metrics_row(label: str, errors: HeldOutErrors) -> str:
+    low, high = (sum(bound) for bound in zip(errors.interval["trans_percent"], errors.interval["rot_percent"]))
+    return (f"| {label} | {errors.trans_percent:.1f} | {errors.rot_percent:.1f} | {errors.trans_mm:.3f} "
+            f"| {errors.rot_deg:.3f} | {errors.combined:.1f} ({low:.1f}–{high:.1f}) |")
 
 
 def _params_text(params: dict) -> str:
@@ -93,137 +342,131 @@ def _uncertainty_row(label: str, scores: dict) -> str:
             f"{scores['calibrated_coverage_68']:.1%} | {scores['calibrated_coverage_95']:.1%} |")
 
 
-def markdown(report: dict, details: dict) -> str:
+def markdown(result: LoopResult) -> str:
     """The readable report."""
+    report, details = result.report, result.details
     header = ("| model | translation % | rotation % | translation mm | rotation deg | sum % (95 % interval) |\n"
               "|---|---|---|---|---|---|")
-    pushes, windows = report["n_pushes"], details["n_windows"]
+    pushes, windows = report.n_pushes, details.n_windows
     roles = ("cross-fitted over sequence folds (every pool push fits and selects, never both for one model)"
-             if details["cross_fitted"] else "one fit split and one select split")
+             if details.cross_fitted else "one fit split and one select split")
+    noise = report.uncertainty.noise
     lines = [
         "# Closing the loop: residual → effect → refit",
         "",
-        f"Data: `{details['data_dir']}`, horizon {details['horizon']} s, seed {details['seed']}. "
+        f"Data: `{details.data_dir}`, horizon {details.horizon} s, seed {details.seed}. "
         f"Pushes: {pushes['fit']} fit, {pushes['select']} select, {pushes['test']} test, {pushes['skipped']} files "
         f"skipped ({windows['fit']} fit, {windows['select']} select and {windows['test']} test windows); effects are "
         f"chosen {roles}, refitted on every push but the test split's, and measured on the test split only. "
-        f"Nominal model: uniform-pressure limit surface, pusher friction {details['pusher_friction']}. Errors are "
+        f"Nominal model: uniform-pressure limit surface, pusher friction {details.pusher_friction}. Errors are "
         "test-split means; % is relative to the `zero` baseline (predicting no motion); intervals are bootstrap "
         "intervals over test push sequences.",
         "",
         "## Before and after (test split)",
         "",
         header,
-        _metrics_row("plain Lynch model", report["baseline"]),
-        _metrics_row("selected: " + (" + ".join(report["selected"]) or "nothing"), report["after"]),
-        _metrics_row("selected + learned error term", report["fallback"]),
+        _metrics_row("plain Lynch model", report.baseline),
+        _metrics_row("selected: " + (" + ".join(report.selected) or "nothing"), report.after),
+        _metrics_row("selected + learned error term", report.fallback),
         "",
         "## How sure the model is (test split)",
         "",
         "Negative log predictive density per window (translation in mm, rotation in deg) and the share of the "
         "outputs (object axes x, y and rotation) inside the central 68 % and 95 % intervals. The physical model's "
         "noise level is fitted on its out-of-fold residual on the select split: "
-        f"{report['uncertainty']['selected']['noise']['x_mm']:.2f} mm, "
-        f"{report['uncertainty']['selected']['noise']['y_mm']:.2f} mm, "
-        f"{report['uncertainty']['selected']['noise']['rotation_deg']:.2f} deg. Gaussian intervals assume that "
-        "noise is normal; the calibrated intervals' half-widths are the quantiles of the out-of-fold standardised "
-        "residuals on the select split (split conformal), so they hold their level on new pushes whatever the "
-        "residual's shape.",
+        f"{1e3 * float(noise[0]):.2f} mm, {1e3 * float(noise[1]):.2f} mm, {float(np.degrees(noise[2])):.2f} deg. "
+        "Gaussian intervals assume that noise is normal; the calibrated intervals' half-widths are the quantiles of "
+        "the out-of-fold standardised residuals on the select split (split conformal), so they hold their level on "
+        "new pushes whatever the residual's shape.",
         "",
         "| model | NLPD | 68 % coverage | 95 % coverage | calibrated 68 % | calibrated 95 % |",
         "|---|---|---|---|---|---|",
-        _uncertainty_row("selected model + fitted noise", report["uncertainty"]["selected"]),
-        _uncertainty_row("learned error term (mean and variance)", report["uncertainty"]["fallback"]),
+        _uncertainty_row("selected model + fitted noise", report.uncertainty.selected),
+        _uncertainty_row("learned error term (mean and variance)", report.uncertainty.fallback),
     ]
     lines += ["", "## Diagnosis of the plain model's residual", "",
               "Strength: share of the translation + rotation error that a cross-fitted correction by the "
               "variable's bins removes (see `pushjax.loop.diagnose`); lower: one-sided bootstrap bound.", "",
               "| variable | strength | lower | axes | beyond noise |", "|---|---|---|---|---|"]
-    lines += [f"| {d['variable']} | {d['strength']:.3f} | {d['lower']:.3f} | {d['frame']} | {d['beyond_noise']} |"
-              for d in details["diagnosis_before"]]
+    lines += [f"| {d.variable} | {d.strength:.3f} | {d.lower:.3f} | {d.frame} | {d.beyond_noise} |"
+              for d in details.diagnosis_before]
     lines += ["", f"![residual of the plain model]({FIGURE_DIR}/residual_baseline.png)", "",
               "## Effects ranked by select-split error (each fitted alone)", "",
               "| effect | parameters (± standard error) | sum % | translation mm | rotation deg |", "|---|---|---|---|---|"]
-    lines += [f"| {entry['effect']} | {_params_text(entry['params'])} | "
-              f"{entry['select']['trans_percent'] + entry['select']['rot_percent']:.1f} | {entry['select']['trans_mm']:.3f} | "
-              f"{entry['select']['rot_deg']:.3f} |" for entry in report["ranking"]]
-    friction, sensor = report["pusher_friction"], report["pusher_friction"]["force_sensor"]
+    lines += [f"| {entry.effect} | {_params_text(entry.params)} | {entry.select.combined:.1f} | "
+              f"{entry.select.trans_mm:.3f} | {entry.select.rot_deg:.3f} |" for entry in report.ranking]
+    friction, sensor = report.pusher_friction, report.pusher_friction.force_sensor
     lines += ["", "## Pusher friction from the force sensor", "",
               (f"While the pusher slid along the object, the force sensor read a pusher–object friction coefficient of "
-               f"{sensor['value']:.3f} ± {sensor['std'] or 0:.3f} ({sensor['n_sequences']} pool sequences, "
-               f"{sensor['n_pushes_without']} pushes without sliding or force; nominal {friction['nominal']:g})"
-               if sensor["value"] is not None else
-               f"No pool push slid with a force reading ({sensor['n_pushes_without']} pushes)") + ". "
-              + (f"Every model uses the measured {friction['used']:.3f}, and `pusher_friction` is not a candidate: "
-                 "a measured parameter is no knob." if friction["from_force_sensor"] else
-                 f"The models use the nominal {friction['used']:g}"
-                 + (" (too few sequences slid for a measurement)." if not sensor["measured"] else "."))]
-    select_floor = details["select_noise_floor"]
+               f"{sensor.value:.3f} ± {sensor.std or 0:.3f} ({sensor.n_sequences} pool sequences, "
+               f"{sensor.n_pushes_without} pushes without sliding or force; nominal {friction.nominal:g})"
+               if sensor.value is not None else
+               f"No pool push slid with a force reading ({sensor.n_pushes_without} pushes)") + ". "
+              + (f"Every model uses the measured {friction.used:.3f}, and `pusher_friction` is not a candidate: "
+                 "a measured parameter is no knob." if friction.from_force_sensor else
+                 f"The models use the nominal {friction.used:g}"
+                 + (" (too few sequences slid for a measurement)." if not sensor.measured else "."))]
+    select_floor = details.select_noise_floor
     lines += ["", "## Forward selection", "",
               f"Every candidate of a round is tested: its gain on the select split must be beyond noise (one-sided "
               f"sign-flip tests over select push sequences, Holm's procedure over the round's candidates at the "
-              f"family-wise level {details['alpha']:g}) and remove more than {details['min_gain']:g} of the current "
-              f"error above the select split's noise floor ({select_floor['trans_percent'] + select_floor['rot_percent']:.1f} "
-              f"% from {select_floor['source']}); of those that pass, the largest gain is added.", ""]
-    for k, round_ in enumerate(details["rounds"], 1):
-        best = round_["accepted"] or max(round_["gains"], key=round_["gains"].get)
-        lines.append(f"{k}. {'added' if round_['accepted'] else 'stop; largest gain'} `{best}`: gain "
-                     f"{round_['gains'][best]:+.3f}, p = {round_['p_values'][best]:.2g} (Holm level "
-                     f"{round_['levels'][best]:.2g}); candidates beyond noise: "
-                     f"{', '.join(name for name, passed in round_['beyond_noise'].items() if passed) or 'none'}")
-        for check in round_["mechanism"]:
-            if check["p_value"] is None:
+              f"family-wise level {details.alpha:g}) and remove more than {details.min_gain:g} of the current "
+              f"error above the select split's noise floor ({select_floor.score:.1f} % from {select_floor.source}); of "
+              f"those that pass, the largest gain is added.", ""]
+    for k, round_ in enumerate(details.rounds, 1):
+        gains = dict(zip(round_.additions, round_.gains))
+        best = round_.accepted or max(gains, key=gains.get)
+        index = round_.additions.index(best)
+        passed = [name for name, beyond in zip(round_.additions, round_.beyond_noise) if beyond]
+        lines.append(f"{k}. {'added' if round_.accepted else 'stop; largest gain'} `{best}`: gain "
+                     f"{round_.gains[index]:+.3f}, p = {round_.p_values[index]:.2g} (Holm level "
+                     f"{round_.levels[index]:.2g}); candidates beyond noise: {', '.join(passed) or 'none'}")
+        for check in round_.mechanism:
+            if check.p_value is None:
                 verdict = "not testable here (one group, or too few sequences per group)"
             else:
-                worst = check["tests"][0]
-                verdict = (f"p = {worst['p_value']:.2g} for agreement of {worst['value']} across {worst['variable']}, "
-                           f"between-group spread {worst['relative_spread']:.2f} of the effect's size: "
-                           + ("**a knob, not a mechanism**" if check["knob"] else "a mechanism"))
-            lines.append(f"   - mechanism check of `{check['effect']}`: {verdict}")
-    if report["selected"]:
+                worst = check.tests[0]
+                verdict = (f"p = {worst.p_value:.2g} for agreement of {worst.value} across {worst.variable}, "
+                           f"between-group spread {worst.relative_spread:.2f} of the effect's size: "
+                           + ("**a knob, not a mechanism**" if check.is_knob(details.alpha) else "a mechanism"))
+            lines.append(f"   - mechanism check of `{check.effect}`: {verdict}")
+    if report.selected:
         lines += ["", "Fitted parameters of the selected model (every pool push):", ""]
-        lines += [f"- {name}: {_params_text(params)}" for name, params in details["selected_params"].items()]
-    if report["per_group"]:
+        lines += [f"- {name}: {_params_text(params)}" for name, params in details.selected_params.items()]
+    if report.per_group:
         lines += ["", "Per object and surface (fitted on each group's pool pushes; shrunk: pulled towards the shared "
                   "value by as much as the group's own error allows; spread: the between-group standard deviation):",
                   "", "| variable | value | shared | spread | p (groups differ) | group: fitted → shrunk |",
                   "|---|---|---|---|---|---|"]
-        lines += [f"| {entry['variable']} | {entry['effect']}.{entry['value']} | {entry['shared']['value']:.4g} ± "
-                  f"{entry['shared']['std']:.2g} | {entry['spread']:.3g} | {entry['p_value']:.2g} | "
+        lines += [f"| {entry.variable} | {entry.effect}.{entry.value} | {entry.shared['value']:.4g} ± "
+                  f"{entry.shared['std']:.2g} | {entry.spread:.3g} | {entry.p_value:.2g} | "
                   + "; ".join(f"{group}: {values['fitted']:.4g} → {values['shrunk']:.4g} ± {values['shrunk_std']:.2g}"
-                              for group, values in entry["groups"].items()) + " |"
-                  for entry in report["per_group"]]
-    fallback = details["fallback_select"]
+                              for group, values in entry.groups.items()) + " |"
+                  for entry in report.per_group]
     lines += ["", "## Residual after the fix (select split, out of fold)", "",
               "| variable | strength | lower | beyond noise |", "|---|---|---|---|"]
-    lines += [f"| {d['variable']} | {d['strength']:.3f} | {d['lower']:.3f} | {d['beyond_noise']} |"
-              for d in details["diagnosis_after"]]
+    lines += [f"| {d.variable} | {d.strength:.3f} | {d.lower:.3f} | {d.beyond_noise} |"
+              for d in details.diagnosis_after]
     lines += ["", f"![residual after the fix]({FIGURE_DIR}/residual_after.png)", "",
               f"![strengths]({FIGURE_DIR}/diagnosis.png)", "",
-              f"Learned error term on the select split: gain {fallback['gain']:+.3f} over the selected model, "
-              f"p = {fallback['p_value']:.2g}.", ""]
-    floor, above = report["noise_floor"], report["remaining"]["above_floor"]
+              f"Learned error term on the select split: gain {details.fallback_gain:+.3f} over the selected model, "
+              f"p = {details.fallback_p_value:.2g}.", ""]
+    floor, above = report.noise_floor, report.above_floor
     lines.append(
-        f"Noise floor of the test split (from {floor['source']}, {floor['n_windows']} windows): translation "
-        f"{floor['trans_percent']:.1f} % ({floor['interval']['trans_percent'][0]:.1f}–{floor['interval']['trans_percent'][1]:.1f}),"
-        f" rotation {floor['rot_percent']:.1f} % ({floor['interval']['rot_percent'][0]:.1f}–"
-        f"{floor['interval']['rot_percent'][1]:.1f}).")
+        f"Noise floor of the test split (from {floor.source}, {floor.n_windows} windows): translation "
+        f"{floor.trans_percent:.1f} % ({floor.interval['trans_percent'][0]:.1f}–{floor.interval['trans_percent'][1]:.1f}),"
+        f" rotation {floor.rot_percent:.1f} % ({floor.interval['rot_percent'][0]:.1f}–"
+        f"{floor.interval['rot_percent'][1]:.1f}).")
     lines.append("")
-    if report["explained"]:
+    if report.explained:
         lines.append("**Explained:** the selected model's test error is within the noise floor's interval.")
     else:
-        remaining = ", ".join(f"**{entry['variable']}** (a correction for it removes {entry['strength']:.1%} of the "
-                              "error)" for entry in report["remaining"]["variables"]) or "no single variable"
+        remaining = ", ".join(f"**{d.variable}** (a correction for it removes {d.strength:.1%} of the error)"
+                              for d in report.remaining) or "no single variable"
         lines.append(
             f"**Not explained:** the selected model's test error is {above['trans_percent']:.1f} (translation) and "
             f"{above['rot_percent']:.1f} (rotation) points of % above the noise floor; the learned error term "
-            f"{'lowers' if fallback['beyond_noise'] else 'does not lower'} the error beyond noise, and the residual "
-            f"still depends on {remaining}. Test-split sum with the learned term "
-            f"{report['fallback']['trans_percent'] + report['fallback']['rot_percent']:.1f} % instead of "
-            f"{report['after']['trans_percent'] + report['after']['rot_percent']:.1f} %.")
+            f"{'lowers' if details.fallback_beyond_noise else 'does not lower'} the error beyond noise, and the "
+            f"residual still depends on {remaining}. Test-split sum with the learned term "
+            f"{report.fallback.combined:.1f} % instead of {report.after.combined:.1f} %.")
     return "\n".join(lines) + "\n"
-
-
-def as_summary(summary: dict) -> dict:
-    """The four error metrics as plain floats."""
-    return {key: float(summary[key]) for key in METRIC_KEYS}

@@ -32,7 +32,7 @@ Geometry and contacts:
   tiny capsule with its axis along the object's x axis, raised by 10° so that only its lower end touches the
   table: MuJoCo's plane–capsule contact takes the capsule axis as the first tangent of the contact frame, which
   ties the friction ellipse of anisotropic contacts to the OBJECT frame (checked in tests/sim).
-* All contacts are explicit ``<pair>`` elements (every geom has ``contype = conaffinity = 0``): table–support
+* All contacts are explicit contact pairs (every geom has ``contype = conaffinity = 0``): table–support
   pairs carry the per-support coefficients ``(mu_x_i, mu_y_i)`` (surface coefficient × area weight × pressure
   weight × anisotropy), tip–wall pairs the isotropic pusher–object coefficient. ``condim`` 3: torsional
   friction of the plate arises from the distributed supports, as in the limit-surface model.
@@ -120,6 +120,13 @@ OUTLINE_TOLERANCE = 1e-5
 """Simplification tolerance (m) applied to a non-convex outline before cutting it into convex pieces."""
 CONVEX_TOLERANCE = 1e-12
 """Cross product (m^2) below which three outline vertices count as collinear when testing convexity."""
+
+_CONTACT_DATA = sum(1 << int(field) for field in (mujoco.mjtConDataField.mjCONDATA_FORCE,
+                                                   mujoco.mjtConDataField.mjCONDATA_TORQUE,
+                                                   mujoco.mjtConDataField.mjCONDATA_POS))
+"""What the pusher's contact sensor reads (MJCF ``data="force torque pos"``)."""
+_CONTACT_NETFORCE = 3
+"""The contact sensor's ``reduce="netforce"`` (MJCF's order: none, mindist, maxforce, netforce)."""
 
 _CVT_FINE_RESOLUTION = 80
 _CVT_ITERATIONS = 40
@@ -254,12 +261,18 @@ def _is_convex(polygon: np.ndarray) -> bool:
     return bool(np.all(turns >= -CONVEX_TOLERANCE))
 
 
-def _numbers(values) -> str:
-    return " ".join(f"{float(v):.10g}" for v in np.ravel(values))
+def _as_written(values) -> np.ndarray:
+    """``values`` rounded to 10 significant digits, as the MJCF text that built the scenes before
+    :func:`scene_spec` wrote them: data sets recorded with either are byte-identical."""
+    return np.array([float(f"{float(v):.10g}") for v in np.ravel(values)])
 
 
-def scene_xml(obj: PushObject | str, surface: str, effects: Effects = Effects(), support: str = "grid") -> str:
-    """MJCF of one scene, self-contained (meshes inline): open it in MuJoCo's viewer or compile it.
+def _written(value: float) -> float:
+    return float(_as_written([value])[0])
+
+
+def scene_spec(obj: PushObject | str, surface: str, effects: Effects = Effects(), support: str = "grid") -> mujoco.MjSpec:
+    """One scene as an editable MuJoCo model specification (meshes inline).
 
     Args:
       obj: the object or its name (see ``pushjax.geometry.OBJECT_NAMES``).
@@ -268,7 +281,7 @@ def scene_xml(obj: PushObject | str, surface: str, effects: Effects = Effects(),
       support: ``"grid"`` or ``"hull"``, see the module docstring.
 
     Returns:
-      The MJCF XML text.
+      The specification; ``.compile()`` gives the model, ``.to_xml()`` its MJCF.
     """
     if isinstance(obj, str):
         obj = get_object(obj)
@@ -277,113 +290,123 @@ def scene_xml(obj: PushObject | str, surface: str, effects: Effects = Effects(),
     surface_spec = get_surface(surface)
     points, _ = support_points(obj, support)
     friction = support_friction(obj, surface, effects, support)
-    half_thickness = obj.thickness / 2
-    com = obj.centroid + np.asarray(effects.com_offset)
-    inertia = obj.inertia_tensor
-    full_inertia = _numbers([inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]])
-    raise_angle = np.radians(SUPPORT_RAISE_DEG)
-    # Capsule axis in the body frame: along +x, raised; its lower end's sphere rests on the plate's bottom.
-    axis = np.array([np.cos(raise_angle), 0.0, np.sin(raise_angle)])
-    capsule_quat = [np.cos((np.pi / 2 - raise_angle) / 2), 0.0, np.sin((np.pi / 2 - raise_angle) / 2), 0.0]
-    support_parameters = f'solref="{_numbers(CONTACT_SOLREF)}" solimp="{_numbers(SUPPORT_SOLIMP)}"'
-    pusher_parameters = f'solref="{_numbers(CONTACT_SOLREF)}" solimp="{_numbers(PUSHER_SOLIMP)}"'
+    half_thickness = _written(obj.thickness / 2)
+    pusher_z = _written(PUSHER_CLEARANCE + PUSHER_HALF_HEIGHT)
+    pusher_size = _as_written([PUSHER_RADIUS, PUSHER_HALF_HEIGHT])
     mu_pusher = pusher_friction(effects)
     pieces = convex_pieces(obj)
-    pusher_z = PUSHER_CLEARANCE + PUSHER_HALF_HEIGHT
 
-    assets = [
-        f'<texture name="table_texture" type="2d" builtin="{surface_spec.texture}" mark="{surface_spec.mark}" '
-        f'random="0.05" rgb1="{_numbers(surface_spec.rgb)}" rgb2="{_numbers(surface_spec.rgb2)}" '
-        f'markrgb="{_numbers(surface_spec.rgb2)}" width="512" height="512"/>',
-        '<material name="table_material" texture="table_texture" texrepeat="4 4" texuniform="true" '
-        'reflectance="0.05"/>',
-        '<material name="steel" rgba="0.72 0.73 0.75 1" specular="0.8" shininess="0.6" reflectance="0.1"/>',
-        '<material name="pusher_material" rgba="0.35 0.36 0.4 1" specular="0.5"/>',
-        f'<mesh name="object_visual" vertex="{_numbers(obj.mesh.vertices)}" face="{_numbers(obj.mesh.faces)}"/>',
-    ]
-    walls = []
+    spec = mujoco.MjSpec()
+    spec.modelname = f"mit_push_{obj.name}_{surface}"
+    spec.compiler.degree = False
+    spec.compiler.autolimits = True
+    spec.option.timestep = _written(TIMESTEP)
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    spec.option.impratio = _written(IMPRATIO)
+    spec.option.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
+    spec.option.solver = mujoco.mjtSolver.mjSOL_CG
+    spec.option.gravity = _as_written(gravity(effects))
+    spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
+    spec.visual.headlight.diffuse = [0.5, 0.5, 0.5]
+    spec.visual.global_.offwidth = 640
+    spec.visual.global_.offheight = 480
+    spec.stat.center = [0.0, 0.0, 0.02]
+    spec.stat.extent = 0.4
+
+    spec.add_texture(name="table_texture", type=mujoco.mjtTexture.mjTEXTURE_2D,
+                     builtin=getattr(mujoco.mjtBuiltin, f"mjBUILTIN_{surface_spec.texture.upper()}"),
+                     mark=getattr(mujoco.mjtMark, f"mjMARK_{surface_spec.mark.upper()}"), random=0.05,
+                     rgb1=_as_written(surface_spec.rgb), rgb2=_as_written(surface_spec.rgb2),
+                     markrgb=_as_written(surface_spec.rgb2), width=512, height=512)
+    textures = [""] * mujoco.mjtTextureRole.mjNTEXROLE
+    textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "table_texture"
+    spec.add_material(name="table_material", textures=textures, texrepeat=[4, 4], texuniform=True, reflectance=0.05)
+    spec.add_material(name="steel", rgba=[0.72, 0.73, 0.75, 1], specular=0.8, shininess=0.6, reflectance=0.1)
+    spec.add_material(name="pusher_material", rgba=[0.35, 0.36, 0.4, 1], specular=0.5)
+    spec.add_mesh(name="object_visual", uservert=_as_written(obj.mesh.vertices),
+                  userface=np.ravel(obj.mesh.faces).astype(int).tolist())
+
+    world = spec.worldbody
+    world.add_light(name="top", pos=[0, 0, 1.5], dir=[0, 0, -1], diffuse=[0.6, 0.6, 0.6])
+    world.add_camera(name="camera", pos=[0, 0, 0.8], fovy=45)
+    world.add_geom(name="table", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[_written(TABLE_HALF_SIZE)] * 2 + [0.01],
+                   material="table_material", contype=0, conaffinity=0)
+
+    plate = world.add_body(name="object", pos=[0, 0, half_thickness])
+    plate.add_freejoint(name="object_joint")
+    inertia = obj.inertia_tensor
+    plate.explicitinertial = True
+    plate.ipos = _as_written([*(obj.centroid + np.asarray(effects.com_offset)), 0.0])
+    plate.mass = _written(obj.mass)
+    plate.fullinertia = _as_written([inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2],
+                                     inertia[1, 2]])
+    plate.add_geom(name="object_visual", type=mujoco.mjtGeom.mjGEOM_MESH, meshname="object_visual", material="steel",
+                   contype=0, conaffinity=0, mass=0)
     for k, piece in enumerate(pieces):
         prism = np.concatenate([np.c_[piece, np.full(len(piece), -half_thickness)],
                                 np.c_[piece, np.full(len(piece), half_thickness)]])
-        assets.append(f'<mesh name="wall{k}" vertex="{_numbers(prism)}"/>')
-        walls.append(f'<geom name="wall{k}" type="mesh" mesh="wall{k}" group="3" contype="0" conaffinity="0" '
-                     f'mass="0" rgba="0.8 0.2 0.2 0.3"/>')
-    supports = []
-    pairs = []
+        spec.add_mesh(name=f"wall{k}", uservert=_as_written(prism))
+        plate.add_geom(name=f"wall{k}", type=mujoco.mjtGeom.mjGEOM_MESH, meshname=f"wall{k}", group=3, contype=0,
+                       conaffinity=0, mass=0, rgba=[0.8, 0.2, 0.2, 0.3])
+    raise_angle = np.radians(SUPPORT_RAISE_DEG)
+    # Capsule axis in the body frame: along +x, raised; its lower end's sphere rests on the plate's bottom.
+    axis = np.array([np.cos(raise_angle), 0.0, np.sin(raise_angle)])
+    capsule_quat = _as_written([np.cos((np.pi / 2 - raise_angle) / 2), 0.0, np.sin((np.pi / 2 - raise_angle) / 2), 0.0])
     for k, point in enumerate(points):
         lower_end_centre = np.array([point[0], point[1], -half_thickness + SUPPORT_RADIUS])
-        centre = lower_end_centre + SUPPORT_HALF_LENGTH * axis
-        supports.append(
-            f'<geom name="support{k}" type="capsule" size="{SUPPORT_RADIUS:.10g} {SUPPORT_HALF_LENGTH:.10g}" '
-            f'pos="{_numbers(centre)}" quat="{_numbers(capsule_quat)}" group="3" contype="0" conaffinity="0" '
-            f'mass="0" rgba="0.2 0.8 0.2 1"/>')
-        pairs.append(
-            f'<pair geom1="table" geom2="support{k}" condim="3" {support_parameters} '
-            f'friction="{_numbers([friction[k, 0], friction[k, 1], TORSIONAL_FRICTION, 0, 0])}"/>')
-    for k in range(len(pieces)):
-        pairs.append(f'<pair geom1="pusher_tip" geom2="wall{k}" condim="3" {pusher_parameters} '
-                     f'friction="{_numbers([mu_pusher, mu_pusher, TORSIONAL_FRICTION, 0, 0])}"/>')
+        plate.add_geom(name=f"support{k}", type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+                       size=[*_as_written([SUPPORT_RADIUS, SUPPORT_HALF_LENGTH]), 0.0],
+                       pos=_as_written(lower_end_centre + SUPPORT_HALF_LENGTH * axis), quat=capsule_quat, group=3,
+                       contype=0, conaffinity=0, mass=0, rgba=[0.2, 0.8, 0.2, 1])
 
-    return f"""<mujoco model="mit_push_{obj.name}_{surface}">
-  <compiler angle="radian" autolimits="true"/>
-  <option timestep="{TIMESTEP:.10g}" integrator="implicitfast" cone="elliptic" impratio="{IMPRATIO:.10g}"
-          jacobian="dense" solver="CG" gravity="{_numbers(gravity(effects))}"/>
-  <visual>
-    <headlight ambient="0.35 0.35 0.35" diffuse="0.5 0.5 0.5"/>
-    <global offwidth="640" offheight="480"/>
-  </visual>
-  <statistic center="0 0 0.02" extent="0.4"/>
-  <asset>
-    {chr(10).join('    ' + line for line in assets).lstrip()}
-  </asset>
-  <worldbody>
-    <light name="top" pos="0 0 1.5" dir="0 0 -1" diffuse="0.6 0.6 0.6"/>
-    <camera name="camera" pos="0 0 0.8" xyaxes="1 0 0 0 1 0" fovy="45"/>
-    <geom name="table" type="plane" size="{TABLE_HALF_SIZE:.10g} {TABLE_HALF_SIZE:.10g} 0.01"
-          material="table_material" contype="0" conaffinity="0"/>
-    <body name="object" pos="0 0 {half_thickness:.10g}">
-      <freejoint name="object_joint"/>
-      <inertial pos="{_numbers([com[0], com[1], 0.0])}" mass="{obj.mass:.10g}" fullinertia="{full_inertia}"/>
-      <geom name="object_visual" type="mesh" mesh="object_visual" material="steel" contype="0" conaffinity="0"
-            mass="0"/>
-      {chr(10).join('      ' + line for line in walls + supports).lstrip()}
-    </body>
-    <body name="pusher" mocap="true" pos="0 0 {pusher_z:.10g}">
-      <geom name="pusher" type="cylinder" size="{PUSHER_RADIUS:.10g} {PUSHER_HALF_HEIGHT:.10g}"
-            material="pusher_material" contype="0" conaffinity="0"/>
-    </body>
-    <body name="pusher_carriage" pos="0 0 {pusher_z:.10g}" gravcomp="1">
-      <joint name="pusher_x" type="slide" axis="1 0 0"/>
-      <joint name="pusher_y" type="slide" axis="0 1 0"/>
-      <geom name="pusher_carriage" type="sphere" size="{PUSHER_RADIUS:.10g}" mass="{PUSHER_MASS:.10g}" group="3"
-            contype="0" conaffinity="0"/>
-      <body name="pusher_tip" gravcomp="1">
-        <joint name="pusher_z" type="slide" axis="0 0 1" stiffness="{TIP_STIFFNESS:.10g}" damping="{TIP_DAMPING:.10g}"/>
-        <geom name="pusher_tip" type="capsule" size="{PUSHER_RADIUS:.10g} {PUSHER_HALF_HEIGHT:.10g}"
-              mass="{TIP_MASS:.10g}" group="3" contype="0" conaffinity="0" rgba="0.2 0.2 0.8 1"/>
-      </body>
-    </body>
-  </worldbody>
-  <actuator>
-    <position name="pusher_x" joint="pusher_x" kp="{PUSHER_KP:.10g}"/>
-    <position name="pusher_y" joint="pusher_y" kp="{PUSHER_KP:.10g}"/>
-    <velocity name="pusher_vx" joint="pusher_x" kv="{PUSHER_KV:.10g}"/>
-    <velocity name="pusher_vy" joint="pusher_y" kv="{PUSHER_KV:.10g}"/>
-  </actuator>
-  <contact>
-    {chr(10).join('    ' + line for line in pairs).lstrip()}
-  </contact>
-  <sensor>
-    <contact name="pusher_contact" body1="pusher_tip" body2="object" data="force torque pos" reduce="netforce"/>
-  </sensor>
-</mujoco>
-"""
+    world.add_body(name="pusher", mocap=True, pos=[0, 0, pusher_z]).add_geom(
+        name="pusher", type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[*pusher_size, 0.0], material="pusher_material",
+        contype=0, conaffinity=0)
+    carriage = world.add_body(name="pusher_carriage", pos=[0, 0, pusher_z], gravcomp=1)
+    carriage.add_joint(name="pusher_x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
+    carriage.add_joint(name="pusher_y", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 1, 0])
+    carriage.add_geom(name="pusher_carriage", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[pusher_size[0], 0, 0],
+                      mass=_written(PUSHER_MASS), group=3, contype=0, conaffinity=0)
+    tip = carriage.add_body(name="pusher_tip", gravcomp=1)
+    tip.add_joint(name="pusher_z", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 0, 1],
+                  stiffness=[_written(TIP_STIFFNESS), 0, 0], damping=[_written(TIP_DAMPING), 0, 0])
+    tip.add_geom(name="pusher_tip", type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[*pusher_size, 0.0],
+                 mass=_written(TIP_MASS), group=3, contype=0, conaffinity=0, rgba=[0.2, 0.2, 0.8, 1])
+
+    for axis_name in ("x", "y"):
+        spec.add_actuator(name=f"pusher_{axis_name}", target=f"pusher_{axis_name}",
+                          trntype=mujoco.mjtTrn.mjTRN_JOINT).set_to_position(kp=_written(PUSHER_KP))
+    for axis_name in ("x", "y"):
+        spec.add_actuator(name=f"pusher_v{axis_name}", target=f"pusher_{axis_name}",
+                          trntype=mujoco.mjtTrn.mjTRN_JOINT).set_to_velocity(kv=_written(PUSHER_KV))
+
+    for k in range(len(points)):
+        spec.add_pair(geomname1="table", geomname2=f"support{k}", condim=3, solref=_as_written(CONTACT_SOLREF),
+                      solimp=_as_written(SUPPORT_SOLIMP),
+                      friction=_as_written([friction[k, 0], friction[k, 1], TORSIONAL_FRICTION, 0, 0]))
+    for k in range(len(pieces)):
+        spec.add_pair(geomname1="pusher_tip", geomname2=f"wall{k}", condim=3, solref=_as_written(CONTACT_SOLREF),
+                      solimp=_as_written(PUSHER_SOLIMP),
+                      friction=_as_written([mu_pusher, mu_pusher, TORSIONAL_FRICTION, 0, 0]))
+    spec.add_sensor(name="pusher_contact", type=mujoco.mjtSensor.mjSENS_CONTACT, objtype=mujoco.mjtObj.mjOBJ_BODY,
+                    objname="pusher_tip", reftype=mujoco.mjtObj.mjOBJ_BODY, refname="object",
+                    intprm=[_CONTACT_DATA, _CONTACT_NETFORCE, 1])
+    return spec
+
+
+def scene_xml(obj: PushObject | str, surface: str, effects: Effects = Effects(), support: str = "grid") -> str:
+    """MJCF of one scene, self-contained (meshes inline), for MuJoCo's viewer; arguments as in :func:`scene_spec`.
+
+    MuJoCo's MJCF writer keeps 6 significant digits: simulate :func:`build_model`, not this text.
+    """
+    return scene_spec(obj, surface, effects, support).to_xml()
 
 
 def build_model(obj: PushObject | str, surface: str, effects: Effects = Effects(),
                 support: str = "grid") -> mujoco.MjModel:
-    """The compiled scene; arguments as in :func:`scene_xml`."""
-    return mujoco.MjModel.from_xml_string(scene_xml(obj, surface, effects, support))
+    """The compiled scene; arguments as in :func:`scene_spec`."""
+    return scene_spec(obj, surface, effects, support).compile()
 
 
 def write_scene(path: str | os.PathLike, obj: PushObject | str, surface: str, effects: Effects = Effects(),

@@ -82,7 +82,7 @@ def loop_report(record, tmp_path_factory):
     def get(name):
         if name not in reports:
             workdir = tmp_path_factory.mktemp(f"loop_{name}")
-            reports[name] = (close_loop(record(name), workdir, progress=False), workdir)
+            reports[name] = (close_loop(record(name), workdir, progress=False).report.as_dict(), workdir)
         return reports[name]
 
     return get

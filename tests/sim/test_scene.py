@@ -1,6 +1,7 @@
 """Tests for pushjax.sim.scene: naming convention, geometry, supports, contacts and the resting plate."""
 
 import xml.dom.minidom
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -188,4 +189,46 @@ def test_write_scene_round_trips(tmp_path):
     model = mujoco.MjModel.from_xml_path(str(path))
     reference = scene.build_model("butter", "pu", Effects(table_tilt_deg=2.0), support="hull")
     assert model.ngeom == reference.ngeom and model.npair == reference.npair
-    np.testing.assert_allclose(model.opt.gravity, reference.opt.gravity)
+    np.testing.assert_allclose(model.opt.gravity, reference.opt.gravity, rtol=1e-5)  # MJCF: 6 significant digits
+    np.testing.assert_allclose(model.pair_friction, reference.pair_friction, rtol=1e-5)
+
+
+@pytest.mark.parametrize("name, surface, effects, support", [
+    ("butter", "abs", Effects(com_offset=(0.01, -0.005), pressure_rim=-2.0, friction_anisotropy=(1.0, 1.5),
+                              table_tilt_deg=4.0, table_tilt_azimuth_deg=30.0, pusher_friction=0.6), "grid"),
+    ("tri2", "plywood", Effects(), "hull"),
+])
+def test_the_spec_builds_the_model_and_simulation_of_the_mjcf_it_replaced(name, surface, effects, support):
+    # mjcf_before_mjspec/ holds the MJCF text that scene_xml wrote before the scenes were built with MjSpec:
+    # a non-convex outline on grid supports with every physical effect, and a convex one on hull supports.
+    path = Path(__file__).parent / "mjcf_before_mjspec" / f"{name}_{surface}_{support}.xml"
+    before = mujoco.MjModel.from_xml_path(str(path))
+    model = scene.build_model(name, surface, effects, support)
+
+    def saved(model):
+        buffer = np.zeros(mujoco.mj_sizeModel(model), np.uint8)
+        mujoco.mj_saveModel(model, None, buffer)
+        return buffer.tobytes()
+
+    assert saved(model) == saved(before)
+
+    def push(model):
+        """Pushes the resting plate along x at 20 mm/s for 1 s; the object's and the pusher's states and the
+        contact sensor at every step."""
+        obj = get_object(name)
+        data = mujoco.MjData(model)
+        data.qpos[2] = obj.thickness / 2
+        y = obj.centroid[1] + 5e-3
+        side = shapely.LineString([(-1.0, y), (1.0, y)]).intersection(shapely.Polygon(obj.outline)).bounds[0]
+        start = np.array([side - PUSHER_RADIUS - 2e-3, y])
+        data.qpos[7:9] = start
+        states = []
+        for k in range(500):
+            data.ctrl[:] = [*(start + [0.02 * k * model.opt.timestep, 0.0]), 0.02, 0.0]
+            mujoco.mj_step(model, data)
+            states.append(np.concatenate([data.qpos, data.qvel, data.sensordata]))
+        return np.array(states)
+
+    pushed = push(model)
+    assert np.linalg.norm(pushed[-1, :2] - pushed[0, :2]) > 1e-3  # the pusher moved the plate
+    assert pushed.tobytes() == push(before).tobytes()
