@@ -26,7 +26,8 @@ Criteria, fixed before measuring (issue 29, part 6):
         [--cases clean,...] [--first_seed 0]
 
 Resumable: recorded pushes are reused, and each analysis is stored in ``<data_dir>/outcomes/<case>_seed<k>.json``
-and not repeated.
+and not repeated. ``--cached_only`` prints the table of the analyses stored so far (a run in progress) and judges the
+goal on them only.
 """
 
 import argparse
@@ -67,11 +68,14 @@ OBJECTS, SURFACES, VELOCITIES, PUSHES_PER_OBJECT = ["hex", "butter"], ["plywood"
 POWER_GOAL, FALSE_DISCOVERY_GOAL, ADDED_ERROR_FOR_GOAL = 0.9, 0.05, 0.2
 
 
-def analyse(data_dir: Path, case: str, seed: int) -> dict:
-    """Records (or reuses) one data set and runs the loop's decision on it; the outcome is cached as JSON."""
+def analyse(data_dir: Path, case: str, seed: int, cached_only: bool = False) -> dict | None:
+    """Records (or reuses) one data set and runs the loop's decision on it; the outcome is cached as JSON.
+    With ``cached_only``, the cached outcome or None."""
     path = data_dir / "outcomes" / f"{case}_seed{seed}.json"
     if path.exists():
         return json.loads(path.read_text())
+    if cached_only:
+        return None
     support, effects = CASES[case]
     pushes = data_dir / case / f"seed{seed}"
     record_pushes(pushes, OBJECTS, SURFACES, PUSHES_PER_OBJECT, seed=seed, velocities=VELOCITIES,
@@ -123,6 +127,7 @@ def main():
     parser.add_argument("--clean_seeds", type=int, default=10, help="data sets per clean case")
     parser.add_argument("--first_seed", type=int, default=0)
     parser.add_argument("--cases", default=",".join(CASES), help="comma-separated cases to analyse (default: all)")
+    parser.add_argument("--cached_only", action="store_true", help="tabulate the stored analyses, run none")
     args = parser.parse_args()
     if args.seeds < 1 or args.clean_seeds < 1 or args.first_seed < 0:
         parser.error(f"--seeds, --clean_seeds, --first_seed: expected >= 1, >= 1, >= 0, got {args.seeds}, "
@@ -138,11 +143,17 @@ def main():
         count = args.clean_seeds if case in CLEAN else args.seeds
         outcomes[case] = []
         for seed in range(args.first_seed, args.first_seed + count):
-            outcome = analyse(args.data_dir, case, seed)
+            outcome = analyse(args.data_dir, case, seed, args.cached_only)
+            if outcome is None:
+                continue
             outcomes[case].append(outcome)
             print(f"{case} seed {seed}: {outcome['selected']} force {outcome['force_sensor']['value']} "
                   f"params {outcome['params']} ({outcome['seconds']:.0f} s; {time.perf_counter() - start:.0f} s)",
                   flush=True)
+    cases = [case for case in cases if outcomes[case]]
+    if "clean" not in cases:
+        print("no clean data set analysed yet")
+        return
     clean = np.mean([outcome["plain_score"] for outcome in outcomes["clean"]])
     print("\n| case | support | testbed effect | plain model sum % | added error | data sets | found | anything beyond "
           "limit_surface, inertia | selections |")
@@ -165,7 +176,8 @@ def main():
             met &= power >= POWER_GOAL
     rate = wrong / clean_total
     met &= rate <= FALSE_DISCOVERY_GOAL
-    judged = "" if len(cases) == len(CASES) else f" (judged on {', '.join(cases)} only)"
+    complete = len(cases) == len(CASES) and not args.cached_only
+    judged = "" if complete else f" (judged on the analyses of {', '.join(cases)} only)"
     print(f"\nfalse discoveries on clean data: {wrong} of {clean_total} ({rate:.0%}; one-sided 95 % upper bound "
           f"{upper_bound(wrong, clean_total):.0%})")
     print(f"goal (power >= {POWER_GOAL:.0%} where the added error >= {ADDED_ERROR_FOR_GOAL:.0%}, false discoveries <= "
