@@ -33,7 +33,7 @@ CROSS_FIT_BELOW = 100
 selects, so the test sees three times the sequences of a 25 % select split). Measured (``python
 benchmarks/close_loop_power.py --start_poses scattered``, BENCHMARKS.md): at 200 pushes a single split of 50 select
 sequences accepted a centre-of-mass offset adding 22 % to the error in 2 of 5 data sets, cross-fitting in 5 of 5,
-with the level kept on a null (``benchmarks/close_loop_level.py``); 100 is twice the size measured short."""
+with the level kept on a sign-flipped null (both scripts as of commit 1135d3f); 100 is twice the size measured short."""
 CROSS_FIT_FOLDS = 4
 TEST_FRACTION = 0.25
 SELECT_FRACTION = 0.25
