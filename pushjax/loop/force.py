@@ -48,18 +48,11 @@ def sliding_friction(push: Push, obj: PushObject, noise: np.ndarray) -> float:
       obj: the pushed object.
       noise: [3] standard deviation of the object pose's tracking noise (x m, y m, yaw rad).
     """
-    dt = float(np.median(np.diff(push.time))) if len(push.time) > 1 else math.inf
-    lag = max(1, round(SLIDE_LAG / dt)) if math.isfinite(dt) else 0
+    lag = _lag(push)
     if lag == 0 or len(push.time) <= lag:
         return math.nan
-    tip, pose = push.tip[:, :2], push.object
-    # Annotated along the pusher's motion over the next lag (at rest: towards the object's centre).
-    motion = np.concatenate([tip[lag:] - tip[:-lag], np.zeros((lag, 2))])
-    towards = pose[:, :2] - tip
-    direction = np.where(np.linalg.norm(motion, axis=1, keepdims=True) > 1e-6, motion, towards)
-    contact = annotate(obj, pose, tip, direction * (0.01 / np.maximum(np.linalg.norm(direction, axis=1),
-                                                                      1e-12))[:, None], radius=PUSHER_RADIUS)
-    touching = np.asarray(contact.touches) & (np.asarray(contact.first_contact_fraction) < 0.05)
+    contact, touching = _touched(push, obj, lag)
+    pose = push.object
     normal = np.asarray(contact.normal)
     local = _moving_average(planar.rotate(np.asarray(contact.contact_rel_com), -pose[:, 2]), lag)
     # Tracking noise of the touched point (object position, and yaw times the lever arm; the tip's adds alike),
@@ -68,7 +61,7 @@ def sliding_friction(push: Push, obj: PushObject, noise: np.ndarray) -> float:
         if np.any(touching) else 0.0
     point_noise = math.sqrt(2.0) * math.hypot(float(np.hypot(noise[0], noise[1])), float(noise[2]) * lever)
     threshold = max(MIN_SLIDE, 4.0 * point_noise * math.sqrt(2.0 / lag))
-    slide = np.zeros(len(tip), bool)
+    slide = np.zeros(len(pose), bool)
     same_side = np.sum(normal[lag:] * normal[:-lag], axis=1) > 0.99
     slide[:-lag] = (touching[:-lag] & touching[lag:] & same_side
                     & (np.linalg.norm(local[lag:] - local[:-lag], axis=1) > threshold))
@@ -80,6 +73,54 @@ def sliding_friction(push: Push, obj: PushObject, noise: np.ndarray) -> float:
     if np.count_nonzero(used) < MIN_SLIDING_SAMPLES:
         return math.nan
     return float(np.percentile(tangential_force[used] / normal_force[used], SLIDING_QUANTILE))
+
+
+def _lag(push: Push) -> int:
+    """Samples in :data:`SLIDE_LAG` (0 for a push of one sample)."""
+    dt = float(np.median(np.diff(push.time))) if len(push.time) > 1 else math.inf
+    return max(1, round(SLIDE_LAG / dt)) if math.isfinite(dt) else 0
+
+
+def _touched(push: Push, obj: PushObject, lag: int):
+    """The contact of every sample, annotated along the pusher's motion over the next ``lag`` samples (at rest:
+    towards the object's centre), and [T] whether the pusher touches the outline there."""
+    tip, pose = push.tip[:, :2], push.object
+    motion = np.concatenate([tip[lag:] - tip[:-lag], np.zeros((lag, 2))])
+    towards = pose[:, :2] - tip
+    direction = np.where(np.linalg.norm(motion, axis=1, keepdims=True) > 1e-6, motion, towards)
+    contact = annotate(obj, pose, tip, direction * (0.01 / np.maximum(np.linalg.norm(direction, axis=1),
+                                                                      1e-12))[:, None], radius=PUSHER_RADIUS)
+    return contact, np.asarray(contact.touches) & (np.asarray(contact.first_contact_fraction) < 0.05)
+
+
+def window_wrenches(push: Push, obj: PushObject, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """The mean wrench the pusher applied to the object over each window.
+
+    Args:
+      push: a cleaned push (wrench [T, 3], the force in N in its first two columns, world axes).
+      obj: the pushed object.
+      starts, ends: [W] window start and end sample indices.
+
+    Returns:
+      [W, 3] force along the object's axes (N) and moment about the object's centre of mass (N·m), averaged over
+      the window's samples at which the pusher touches and the force is loaded; NaN where there are none.
+    """
+    wrenches = np.full((len(starts), 3), np.nan)
+    lag = _lag(push)
+    if lag == 0 or len(push.time) <= lag:
+        return wrenches
+    contact, touching = _touched(push, obj, lag)
+    force = push.wrench[:, :2]
+    arm = np.asarray(contact.contact_rel_com)
+    moment = arm[:, 0] * force[:, 1] - arm[:, 1] * force[:, 0]
+    magnitude = np.linalg.norm(force, axis=1)
+    used = touching & (magnitude > MIN_NORMAL_FORCE_SHARE * max(float(np.max(magnitude, initial=0.0)), 1e-9))
+    local = np.column_stack([planar.rotate(force, -push.object[:, 2]), moment])
+    for k, (start, end) in enumerate(zip(starts, ends)):
+        inside = used[start:end]
+        if np.any(inside):
+            wrenches[k] = local[start:end][inside].mean(axis=0)
+    return wrenches
 
 
 def _moving_average(values: np.ndarray, width: int) -> np.ndarray:
@@ -133,3 +174,4 @@ def estimate(push_friction: np.ndarray, push: np.ndarray, sequence: np.ndarray) 
         value=float(np.mean(per_sequence)) if n else None,
         std=float(np.std(per_sequence, ddof=1) / math.sqrt(n)) if n > 1 else None,
         n_sequences=n, n_pushes=int(np.count_nonzero(known)), n_pushes_without=int(np.count_nonzero(~known)))
+

@@ -23,6 +23,7 @@ from pushjax.loop import hierarchy as hierarchy_lib
 from pushjax.loop import metrics
 from pushjax.loop import report as report_lib
 from pushjax.loop import select as select_lib
+from pushjax.loop import shape as shape_lib
 from pushjax.loop import splits as splits_lib
 from pushjax.loop.windows import NOMINAL_PUSHER_FRICTION, Examples, build_examples
 from pushjax.mit.files import iter_pushes
@@ -268,6 +269,9 @@ def close_loop(
                 fallback=metrics.predictive_scores(fallback_mean, fallback_std, test.target, yaw,
                                                    decision.fallback_multipliers)),
             per_group=per_group,
+            limit_surface_shape=shape_lib.limit_surface_shape(
+                shape_lib.measured_twists(pool), pool.wrench, pool.inputs.l, pool.sequence,
+                shape_lib.shape_models(pool, model.params if model is not None else None), settings.n_bootstrap, seed),
         )
         stages.update()
 

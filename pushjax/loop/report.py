@@ -14,6 +14,7 @@ import numpy as np
 from pushjax.loop import diagnose as diagnose_lib
 from pushjax.loop import force as force_lib
 from pushjax.loop import hierarchy
+from pushjax.loop import shape as shape_lib
 from pushjax.loop import metrics
 from pushjax.loop import select as select_lib
 from pushjax.loop.windows import CATEGORICAL, VARIABLES, Examples
@@ -121,6 +122,8 @@ class LoopReport:
       uncertainty: how sure the selected model and the learned error term are.
       per_group: the selected model's values per object and per surface, shrunk to a shared value (empty when
         nothing is selected or the pool has one object and one surface).
+      limit_surface_shape: the limit surface's torque-to-force ratio per twist regime from the pool's force-motion
+        pairs, beside Lynch's ellipsoid's, the exact uniform surface's and the selected model's.
     """
 
     n_pushes: dict[str, int]
@@ -135,6 +138,7 @@ class LoopReport:
     remaining: list[diagnose_lib.Dependence]
     uncertainty: Uncertainty
     per_group: list[hierarchy.GroupValues]
+    limit_surface_shape: shape_lib.LimitSurfaceShape
 
     @property
     def above_floor(self) -> dict[str, float]:
@@ -160,6 +164,10 @@ class LoopReport:
                                 "force_sensor": self.pusher_friction.force_sensor.as_dict()},
             "explained": self.explained,
             "per_group": [dataclasses.asdict(values) for values in self.per_group],
+            "limit_surface_shape": {
+                **dataclasses.asdict(self.limit_surface_shape),
+                "regimes": [[low, high if math.isfinite(high) else None]
+                            for low, high in self.limit_surface_shape.regimes]},
             "fallback": dataclasses.asdict(self.fallback),
             "remaining": {"above_floor": self.above_floor, "variables": _strengths(self.remaining)},
             "uncertainty": {
@@ -337,6 +345,26 @@ def _params_text(params: dict) -> str:
     return ", ".join(f"{name} = {value['value']:.4g} ± {spread(value['std'])}" for name, value in params.items()) or "-"
 
 
+def _shape_lines(shape: shape_lib.LimitSurfaceShape) -> list[str]:
+    """The force sensor's torque-to-force ratio per twist regime beside the models' (report.md)."""
+    if not any(shape.measured):
+        return ["", "Limit surface from the force sensor: too few windows with force and motion to measure its shape."]
+    names = list(shape.models)
+    lines = ["", "Limit surface from the force sensor (pool pushes): the torque-to-force ratio `c_eff / l` of the "
+             "wrench the pusher applied and the twist the object made (`|m| |v| / (|ω| |F|)`, ratio of sums per "
+             "regime, sequence-bootstrap standard error), beside the models' at the same twists. Lynch's ellipsoid "
+             "is 1 everywhere; a surface of the right shape follows the sensor in every regime.", "",
+             "| rotation against translation, ω l / v | measured | windows | " + " | ".join(names) + " |",
+             "|---|---|---|" + "---|" * len(names)]
+    for (low, high), measured, index in zip(shape.regimes, shape.measured, range(len(shape.regimes))):
+        if measured is None:
+            continue
+        regime = f"{low:g}–{high:g}" if math.isfinite(high) else f"≥ {low:g}"
+        lines.append(f"| {regime} | {measured['c_over_l']:.3f} ± {measured['std']:.3f} | {measured['n_windows']} | "
+                     + " | ".join(f"{shape.models[name][index]:.3f}" for name in names) + " |")
+    return lines
+
+
 def _uncertainty_row(label: str, scores: dict) -> str:
     return (f"| {label} | {scores['nlpd']:.2f} | {scores['coverage_68']:.1%} | {scores['coverage_95']:.1%} | "
             f"{scores['calibrated_coverage_68']:.1%} | {scores['calibrated_coverage_95']:.1%} |")
@@ -433,6 +461,7 @@ def markdown(result: LoopResult) -> str:
     if report.selected:
         lines += ["", "Fitted parameters of the selected model (every pool push):", ""]
         lines += [f"- {name}: {_params_text(params)}" for name, params in details.selected_params.items()]
+    lines += _shape_lines(report.limit_surface_shape)
     if report.per_group:
         lines += ["", "Per object and surface (fitted on each group's pool pushes; shrunk: pulled towards the shared "
                   "value by as much as the group's own error allows; spread: the between-group standard deviation):",

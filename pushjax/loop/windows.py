@@ -26,7 +26,7 @@ import numpy as np
 
 from pushjax import planar
 from pushjax.geometry import OBJECT_NAMES, PUSHER_RADIUS, annotate, get_object, limit_surface_ratio, support_cells
-from pushjax.loop.force import sliding_friction
+from pushjax.loop.force import sliding_friction, window_wrenches
 from pushjax.mit.files import Push
 from pushjax.physics.effects import PushInputs
 
@@ -71,6 +71,8 @@ class Examples:
         estimated from the pose stream (:func:`tracking_noise`).
       push_friction: [N] the pusher–object friction coefficient that the force sensor read while the window's push
         slid (:func:`pushjax.loop.force.sliding_friction`; NaN where it never slid or read no force).
+      wrench: [N, 3] the mean wrench the pusher applied over the window: force along the object's axes (N) and moment
+        about its centre of mass (N·m) (:func:`pushjax.loop.force.window_wrenches`; NaN where it never touched).
       variables: {name: [N] values} of the candidate explanatory variables (see :data:`VARIABLES`).
       sequence_names: names of the sequences, indexed by ``sequence``.
     """
@@ -82,6 +84,7 @@ class Examples:
     window: np.ndarray
     tracking_noise: np.ndarray
     push_friction: np.ndarray
+    wrench: np.ndarray
     variables: dict[str, np.ndarray]
     sequence_names: tuple[str, ...]
 
@@ -101,7 +104,7 @@ class Examples:
         return Examples(
             inputs=jax.tree.map(lambda values: np.asarray(values)[mask], self.inputs),
             target=self.target[mask], sequence=self.sequence[mask], push=self.push[mask], window=self.window[mask],
-            tracking_noise=self.tracking_noise[mask], push_friction=self.push_friction[mask],
+            tracking_noise=self.tracking_noise[mask], push_friction=self.push_friction[mask], wrench=self.wrench[mask],
             variables={name: values[mask] for name, values in self.variables.items()}, sequence_names=self.sequence_names,
         )
 
@@ -230,6 +233,7 @@ def build_examples(
             window=np.arange(len(starts)),
             tracking_noise=np.broadcast_to(noise, (len(starts), 3)),
             push_friction=np.full(len(starts), sliding_friction(push, get_object(push.params.shape), noise)),
+            wrench=window_wrenches(push, get_object(push.params.shape), starts, ends),
             params=push.params,
         ))
     if n_pushes == 0:
@@ -248,7 +252,7 @@ def build_examples(
     inputs = PushInputs(**{field.name: merged[field.name] for field in dataclasses.fields(PushInputs)})
     examples = Examples(inputs=inputs, target=merged["target"], sequence=merged["sequence"], push=merged["push"],
                         window=merged["window"], tracking_noise=merged["tracking_noise"],
-                        push_friction=merged["push_friction"], variables=variables,
+                        push_friction=merged["push_friction"], wrench=merged["wrench"], variables=variables,
                         sequence_names=tuple(sequence_index))
     return examples, BuildSummary(n_pushes=n_pushes, skipped=dict(skipped))
 
@@ -303,7 +307,7 @@ def _annotate_object(name: str, rows: list[dict], pusher_friction: float) -> dic
         patch_radius=np.full(count, patch_radius),
         target=np.column_stack([com1 - com0, pose1[:, 2] - pose0[:, 2]]),
         sequence=data["sequence"], push=data["push"], window=data["window"], tracking_noise=data["tracking_noise"],
-        push_friction=data["push_friction"],
+        push_friction=data["push_friction"], wrench=data["wrench"],
         variables=variables,
     )
 

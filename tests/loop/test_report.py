@@ -3,9 +3,11 @@
 ``report_small/`` holds the files of a small hand-made result. Its ``report.md`` files were first written by the
 markdown code from before the results were typed (which read the two JSON files' dicts back by key), and the JSON files
 had the keys, in order, of the files that code's loop wrote: the typed results changed no key and no byte. Since then
-the files gained the per-group values (``per_group``) and the calibrated coverages, and nothing else.
+the files gained the per-group values (``per_group``), the calibrated coverages and the limit surface's shape from the
+force sensor (``limit_surface_shape``), and nothing else.
 """
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +17,7 @@ from pushjax.loop.diagnose import Dependence
 from pushjax.loop.force import ForceFriction
 from pushjax.loop.hierarchy import GroupValues
 from pushjax.loop.metrics import NoiseFloor
+from pushjax.loop.shape import LimitSurfaceShape
 from pushjax.loop.select import Heterogeneity, MechanismCheck, Round
 
 EXPECTED = Path(__file__).parent / "report_small"
@@ -79,6 +82,12 @@ def small_result(measured_friction: bool) -> report_lib.LoopResult:
                                groups={"abs": {"fitted": 14.0, "fitted_std": 1.5, "shrunk": 14.25, "shrunk_std": 1.0},
                                        "pu": {"fitted": 15.0, "fitted_std": 1.5, "shrunk": 14.75, "shrunk_std": 1.0}})]
         if measured_friction else [],
+        limit_surface_shape=LimitSurfaceShape(
+            regimes=[(0.0, 0.3), (0.3, 1.0), (1.0, math.inf)],
+            measured=[{"c_over_l": 0.75, "std": 0.0125, "n_windows": 250, "n_sequences": 50}, None,
+                      {"c_over_l": 1.0625, "std": 0.00390625, "n_windows": 150, "n_sequences": 36}],
+            models={"Lynch's ellipsoid (l)": [1.0, None, 1.0], "exact surface, uniform pressure": [0.78125, None, 1.0]}
+        ) if measured_friction else LimitSurfaceShape(regimes=[(0.0, math.inf)], measured=[None], models={}),
     )
     details = report_lib.LoopDetails(
         data_dir="/data/pushes", horizon=0.5, seed=3, pusher_friction=0.25, alpha=0.05, min_gain=0.1,

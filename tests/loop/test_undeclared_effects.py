@@ -48,7 +48,8 @@ def test_report_follows_the_schema(loop_report):
     report, workdir = loop_report("com_offset")
     assert json.loads((workdir / "report.json").read_text()) == report
     assert set(report) == {"n_pushes", "baseline", "diagnosis", "ranking", "selected", "after", "noise_floor",
-                           "pusher_friction", "explained", "fallback", "remaining", "uncertainty", "per_group"}
+                           "pusher_friction", "explained", "fallback", "remaining", "uncertainty", "per_group",
+                           "limit_surface_shape"}
     assert report["per_group"] == []  # one object on one surface: no groups to fit apart
     friction = report["pusher_friction"]
     assert set(friction) == {"nominal", "force_sensor", "from_force_sensor", "used"}
