@@ -235,6 +235,10 @@ def close_loop(
         pool, test = split.pool, split.test
         model = selection.model
         per_group = hierarchy_lib.hierarchical(pool, model, settings.fit) if model is not None else []
+        shape = shape_lib.limit_surface_shape(
+            shape_lib.measured_twists(pool), pool.wrench, pool.inputs.l, pool.sequence,
+            shape_lib.shape_models(pool, model.params if model is not None else None), settings.n_bootstrap, seed)
+        shape = dataclasses.replace(shape, rim_from_force=shape_lib.rim_from_force(pool, shape))
         term = correction_lib.fit_error_correction(pool, fit_lib.predict([model], pool)[0], settings.correction, seed)
         plain_test, model_test = fit_lib.predict([None, model], test)
         fallback_mean, fallback_std = term(test, model_test)
@@ -269,9 +273,7 @@ def close_loop(
                 fallback=metrics.predictive_scores(fallback_mean, fallback_std, test.target, yaw,
                                                    decision.fallback_multipliers)),
             per_group=per_group,
-            limit_surface_shape=shape_lib.limit_surface_shape(
-                shape_lib.measured_twists(pool), pool.wrench, pool.inputs.l, pool.sequence,
-                shape_lib.shape_models(pool, model.params if model is not None else None), settings.n_bootstrap, seed),
+            limit_surface_shape=shape,
         )
         stages.update()
 

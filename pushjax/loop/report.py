@@ -345,8 +345,9 @@ def _params_text(params: dict) -> str:
     return ", ".join(f"{name} = {value['value']:.4g} ± {spread(value['std'])}" for name, value in params.items()) or "-"
 
 
-def _shape_lines(shape: shape_lib.LimitSurfaceShape) -> list[str]:
-    """The force sensor's torque-to-force ratio per twist regime beside the models' (report.md)."""
+def _shape_lines(shape: shape_lib.LimitSurfaceShape, fitted: dict | None) -> list[str]:
+    """The force sensor's torque-to-force ratio per twist regime beside the models' (report.md), and the pressure's
+    rim loading from the force data beside the motion fit's (``fitted``: the selected ``limit_surface`` values)."""
     if not any(shape.measured):
         return ["", "Limit surface from the force sensor: too few windows with force and motion to measure its shape."]
     names = list(shape.models)
@@ -362,6 +363,18 @@ def _shape_lines(shape: shape_lib.LimitSurfaceShape) -> list[str]:
         regime = f"{low:g}–{high:g}" if math.isfinite(high) else f"≥ {low:g}"
         lines.append(f"| {regime} | {measured['c_over_l']:.3f} ± {measured['std']:.3f} | {measured['n_windows']} | "
                      + " | ".join(f"{shape.models[name][index]:.3f}" for name in names) + " |")
+    rim = shape.rim_from_force
+    if rim is not None:
+        lines += ["", f"Pressure rim loading (`limit_surface.rim`) from the force data alone: {rim['value']:.3g} ± "
+                  f"{rim['std']:.2g}."]
+        motion = (fitted or {}).get("rim")
+        if motion is not None and motion["std"]:
+            weights = np.array([1 / motion["std"] ** 2, 1 / rim["std"] ** 2])
+            value = float(np.dot(weights, [motion["value"], rim["value"]]) / weights.sum())
+            std = float(1 / np.sqrt(weights.sum()))
+            lines[-1] += (f" From the motion fit: {motion['value']:.3g} ± {motion['std']:.2g}; both together: "
+                          f"{value:.3g} ± {std:.2g}, an interval {motion['std'] / std:.2g} times narrower than the "
+                          "motion's alone.")
     return lines
 
 
@@ -461,7 +474,7 @@ def markdown(result: LoopResult) -> str:
     if report.selected:
         lines += ["", "Fitted parameters of the selected model (every pool push):", ""]
         lines += [f"- {name}: {_params_text(params)}" for name, params in details.selected_params.items()]
-    lines += _shape_lines(report.limit_surface_shape)
+    lines += _shape_lines(report.limit_surface_shape, details.selected_params.get("limit_surface"))
     if report.per_group:
         lines += ["", "Per object and surface (fitted on each group's pool pushes; shrunk: pulled towards the shared "
                   "value by as much as the group's own error allows; spread: the between-group standard deviation):",

@@ -48,11 +48,14 @@ class LimitSurfaceShape:
       measured: per regime {"c_over_l", "std" (sequence bootstrap), "n_windows", "n_sequences"}, or None with fewer
         than :data:`MIN_SHAPE_WINDOWS` windows.
       models: {model: [per regime c_eff / l or None]} of the named models' wrenches at the same twists.
+      rim_from_force: the support pressure's rim loading that the force data alone gives (:func:`rim_from_force`),
+        {"value", "std"}, or None.
     """
 
     regimes: list[tuple[float, float]]
     measured: list[dict | None]
     models: dict[str, list[float | None]]
+    rim_from_force: dict[str, float] | None = None
 
 
 def limit_surface_shape(twist: np.ndarray, wrench: np.ndarray, l: np.ndarray, sequence: np.ndarray,
@@ -68,22 +71,13 @@ def limit_surface_shape(twist: np.ndarray, wrench: np.ndarray, l: np.ndarray, se
       n_bootstrap, seed: the sequence bootstrap of the measured ratios.
     """
     twist, wrench, l = np.asarray(twist, np.float64), np.asarray(wrench, np.float64), np.asarray(l, np.float64)
-    speed, spin = np.linalg.norm(twist[:, :2], axis=1), np.abs(twist[:, 2])
-    usable = np.all(np.isfinite(wrench), axis=1) & (speed > 0) & (spin > 0)
-    regime_of = spin * l / np.where(speed > 0, speed, 1.0)
-
-    def sums(pair):
-        return np.abs(pair[:, 2]) * speed / l, spin * np.linalg.norm(pair[:, :2], axis=1) * l
-
-    measured, predicted = [], {name: [] for name in models}
-    for low, high in SHAPE_REGIMES:
-        inside = usable & (regime_of >= low) & (regime_of < high)
-        if np.count_nonzero(inside) < MIN_SHAPE_WINDOWS:
+    regimes = _regimes(twist, wrench, l)
+    measured = []
+    for inside in regimes:
+        if inside is None:
             measured.append(None)
-            for name in models:
-                predicted[name].append(None)
             continue
-        torque, force = (values[inside] for values in sums(wrench))
+        torque, force = (values[inside] for values in _sums(wrench, twist, l))
         ids, index = np.unique(sequence[inside], return_inverse=True)
         per_sequence = np.zeros((len(ids), 2))
         np.add.at(per_sequence, index, np.column_stack([torque, force]))
@@ -92,10 +86,77 @@ def limit_surface_shape(twist: np.ndarray, wrench: np.ndarray, l: np.ndarray, se
         ratios = np.sqrt(resampled[:, 0] / np.maximum(resampled[:, 1], 1e-300))
         measured.append({"c_over_l": float(np.sqrt(torque.sum() / force.sum())), "std": float(np.std(ratios, ddof=1)),
                          "n_windows": int(np.count_nonzero(inside)), "n_sequences": len(ids)})
-        for name, model_wrench in models.items():
-            model_torque, model_force = (values[inside] for values in sums(np.asarray(model_wrench, np.float64)))
-            predicted[name].append(float(np.sqrt(model_torque.sum() / model_force.sum())))
-    return LimitSurfaceShape(regimes=list(SHAPE_REGIMES), measured=measured, models=predicted)
+    return LimitSurfaceShape(regimes=list(SHAPE_REGIMES), measured=measured,
+                             models={name: _model_ratios(regimes, np.asarray(model, np.float64), twist, l)
+                                     for name, model in models.items()})
+
+
+def _regimes(twist: np.ndarray, wrench: np.ndarray, l: np.ndarray) -> list[np.ndarray | None]:
+    """Per regime of :data:`SHAPE_REGIMES`, [N] which windows with a force reading and motion fall in it (None: fewer
+    than :data:`MIN_SHAPE_WINDOWS`)."""
+    speed, spin = np.linalg.norm(twist[:, :2], axis=1), np.abs(twist[:, 2])
+    usable = np.all(np.isfinite(wrench), axis=1) & (speed > 0) & (spin > 0)
+    regime_of = spin * l / np.where(speed > 0, speed, 1.0)
+    masks = [usable & (regime_of >= low) & (regime_of < high) for low, high in SHAPE_REGIMES]
+    return [mask if np.count_nonzero(mask) >= MIN_SHAPE_WINDOWS else None for mask in masks]
+
+
+def _sums(wrench: np.ndarray, twist: np.ndarray, l: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """[N] ``|m| |v| / l`` and ``|omega| |F| l``: their sums' ratio is ``(c_eff / l)^2``."""
+    return (np.abs(wrench[:, 2]) * np.linalg.norm(twist[:, :2], axis=1) / l,
+            np.abs(twist[:, 2]) * np.linalg.norm(wrench[:, :2], axis=1) * l)
+
+
+def _model_ratios(regimes: list[np.ndarray | None], wrench: np.ndarray, twist: np.ndarray,
+                  l: np.ndarray) -> list[float | None]:
+    torque, force = _sums(wrench, twist, l)
+    return [None if inside is None else float(np.sqrt(torque[inside].sum() / force[inside].sum()))
+            for inside in regimes]
+
+
+RIM_GRID = np.linspace(-10.0, 10.0, 41)
+"""Pressure rim loadings (``pushjax.physics.effects.support_pressure``) searched by :func:`rim_from_force`."""
+
+
+def rim_from_force(examples: Examples, measured: LimitSurfaceShape) -> dict[str, float] | None:
+    """The support pressure's rim loading whose exact limit surface matches the sensor's ratios.
+
+    Least squares over the measured regimes, each weighted by its standard error (regimes are disjoint sets of windows,
+    taken as independent), on :data:`RIM_GRID` refined by a parabola through the best point and its neighbours; the
+    standard error is where chi-square rises by 1.
+
+    Returns:
+      {"value", "std"}, or None when fewer than two regimes are measured or the best fit is at the grid's edge.
+    """
+    known = [k for k, entry in enumerate(measured.measured) if entry is not None]
+    if len(known) < 2:
+        return None
+    twist, inputs = measured_twists(examples), examples.inputs
+    l = np.asarray(inputs.l, np.float64)
+    regimes = _regimes(twist, np.asarray(examples.wrench, np.float64), l)
+    target = np.array([measured.measured[k]["c_over_l"] for k in known])
+    std = np.array([max(measured.measured[k]["std"], 1e-9) for k in known])
+    chi_square = []
+    for rim in RIM_GRID:
+        ratios = _model_ratios(regimes, _exact_wrench(twist, inputs, rim), twist, l)
+        chi_square.append(float(np.sum(((np.array([ratios[k] for k in known]) - target) / std) ** 2)))
+    best = int(np.argmin(chi_square))
+    if best in (0, len(RIM_GRID) - 1):
+        return None
+    curvature, slope, _ = np.polyfit(RIM_GRID[best - 1:best + 2], chi_square[best - 1:best + 2], 2)
+    if not curvature > 0:
+        return None
+    return {"value": float(-slope / (2 * curvature)), "std": float(1.0 / np.sqrt(curvature))}
+
+
+def _exact_wrench(twist: np.ndarray, inputs, rim: float) -> np.ndarray:
+    """[N, 3] the exact limit surface's wrench at ``twist`` for a pressure of rim loading ``rim`` (0: uniform)."""
+    weights = np.asarray(inputs.support_weights)
+    if rim != 0:
+        weights = np.asarray(effects_lib.support_pressure({"rim": rim}, jnp.asarray(inputs.support_points),
+                                                          jnp.asarray(weights)))
+    return np.asarray(limit_surface_lib.dissipation(twist, inputs.support_points, weights, inputs.patch_radius)[1],
+                      np.float64)
 
 
 def shape_models(examples: Examples, fitted: dict[str, dict] | None) -> dict[str, np.ndarray]:
@@ -115,14 +176,10 @@ def shape_models(examples: Examples, fitted: dict[str, dict] | None) -> dict[str
         scale = float(np.exp(fitted["friction_ratio"]["log_scale"]))
         models[f"ellipsoid, fitted friction_ratio ({scale:.3g} l)"] = np.column_stack(
             [twist[:, :2], twist[:, 2] * (scale * l) ** 2])
-    pressures = {"exact surface, uniform pressure": np.asarray(inputs.support_weights)}
+    models["exact surface, uniform pressure"] = _exact_wrench(twist, inputs, 0.0)
     if "limit_surface" in fitted:
         rim = float(fitted["limit_surface"]["rim"])
-        pressures[f"exact surface, fitted pressure (rim {rim:.3g})"] = np.asarray(effects_lib.support_pressure(
-            {"rim": rim}, jnp.asarray(inputs.support_points), jnp.asarray(inputs.support_weights)))
-    for name, weights in pressures.items():
-        models[name] = np.asarray(limit_surface_lib.dissipation(twist, inputs.support_points, weights,
-                                                                inputs.patch_radius)[1], np.float64)
+        models[f"exact surface, fitted pressure (rim {rim:.3g})"] = _exact_wrench(twist, inputs, rim)
     return models
 
 
