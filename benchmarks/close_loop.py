@@ -20,8 +20,9 @@ import time
 from pathlib import Path
 
 from pushjax.loop import close_loop
-from pushjax.sim.dataset import record_pushes
+from pushjax.sim.dataset import RecordingSettings, record_pushes
 from pushjax.sim.effects import Effects
+from pushjax.sim.testbed import IDEAL
 
 OBJECTS = ["rect1", "tri1", "ellip2", "hex", "butter"]
 SURFACES = ["abs", "plywood"]
@@ -42,9 +43,10 @@ def main():
         data_dir = args.data_dir or Path(scratch) / "pushes"
         workdir = args.workdir or Path(scratch) / "loop"
         start = time.perf_counter()
-        recorded = record_pushes(data_dir, OBJECTS, SURFACES, args.pushes_per_pair, seed=args.seed,
-                                 velocities=VELOCITIES, effects=Effects.parse(args.effects), declare_effects=False,
-                                 workers=args.workers, progress=True)
+        settings = RecordingSettings(seed=args.seed, velocities=VELOCITIES, effects=Effects.parse(args.effects),
+                                     declare_effects=False, testbed=IDEAL)
+        recorded = record_pushes(data_dir, OBJECTS, SURFACES, args.pushes_per_pair, settings, workers=args.workers,
+                                 progress=True)
         print(f"recorded {len(recorded.written)} pushes ({len(recorded.skipped)} reused) in "
               f"{time.perf_counter() - start:.1f} s")
         start, cpu = time.perf_counter(), _cpu_seconds()

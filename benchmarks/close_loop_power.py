@@ -43,7 +43,7 @@ from pushjax.loop import metrics
 from pushjax.loop.pipeline import LoopSettings, decide
 from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes
-from pushjax.sim.dataset import record_pushes
+from pushjax.sim.dataset import RecordingSettings, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.testbed import IDEAL
 
@@ -78,9 +78,9 @@ def analyse(data_dir: Path, case: str, seed: int, cached_only: bool = False) -> 
         return None
     support, effects = CASES[case]
     pushes = data_dir / case / f"seed{seed}"
-    record_pushes(pushes, OBJECTS, SURFACES, PUSHES_PER_OBJECT, seed=seed, velocities=VELOCITIES,
-                  effects=Effects.parse(effects), declare_effects=False, support=support, testbed=IDEAL, workers=1,
-                  progress=False)
+    settings = RecordingSettings(seed=seed, velocities=VELOCITIES, effects=Effects.parse(effects),
+                                 declare_effects=False, support=support, testbed=IDEAL)
+    record_pushes(pushes, OBJECTS, SURFACES, PUSHES_PER_OBJECT, settings, workers=1, progress=False)
     start = time.perf_counter()
     examples = build_examples(iter_pushes(pushes))[0]
     plain = metrics.window_errors(fit_lib.predict([None], examples)[0], examples.target, examples.sequence)

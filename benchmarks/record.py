@@ -12,6 +12,7 @@ import tempfile
 import time
 
 from pushjax.sim import dataset
+from pushjax.sim.testbed import IDEAL
 
 
 def main():
@@ -24,10 +25,11 @@ def main():
 
     with tempfile.TemporaryDirectory() as root:
         # Plan once so that the timed run only simulates and writes.
-        dataset.plan_pushes(root, [args.object], ["abs"], args.pushes, velocities=(args.velocity,))
+        settings = dataset.RecordingSettings(velocities=(args.velocity,), testbed=IDEAL)
+        dataset.plan_pushes(root, [args.object], ["abs"], args.pushes, settings)
         start = time.perf_counter()
-        summary = dataset.record_pushes(root, [args.object], ["abs"], args.pushes, velocities=(args.velocity,),
-                                        workers=args.workers, progress=False)
+        summary = dataset.record_pushes(root, [args.object], ["abs"], args.pushes, settings, workers=args.workers,
+                                        progress=False)
         elapsed = time.perf_counter() - start
     count = len(summary.written)
     print(f"{count} pushes of {args.object} at {args.velocity:g} mm/s with {args.workers} workers: {elapsed:.2f} s, "

@@ -38,7 +38,7 @@ from absl import app, flags
 
 import experiments
 from pushjax.geometry import OBJECT_NAMES
-from pushjax.sim.dataset import START_POSES, OutDirConflictError, record_pushes
+from pushjax.sim.dataset import START_POSES, OutDirConflictError, RecordingSettings, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
 from pushjax.sim.testbed import from_flags
@@ -113,13 +113,14 @@ def main(argv):
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
     try:
-        summary = record_pushes(
-            _OUT_DIR.value, _OBJECTS.value, _SURFACES.value, _PUSHES.value, seed=_SEED.value,
-            velocities=_numbers("velocities", _VELOCITIES.value, 0.0, strict=True),
+        settings = RecordingSettings(
+            seed=_SEED.value, velocities=_numbers("velocities", _VELOCITIES.value, 0.0, strict=True),
             accelerations=_numbers("accelerations", _ACCELERATIONS.value, 0.0, strict=False),
             repeats=_REPEATS.value, effects=Effects.parse(_EFFECTS.value), declare_effects=_DECLARE.value,
             support=_SUPPORT.value, testbed=from_flags(_TESTBED.value, _TESTBED_OVERRIDES.value),
-            workers=_WORKERS.value, start_poses=_START_POSES.value)
+            start_poses=_START_POSES.value)
+        summary = record_pushes(_OUT_DIR.value, _OBJECTS.value, _SURFACES.value, _PUSHES.value, settings,
+                                workers=_WORKERS.value)
     except OutDirConflictError as error:
         raise app.UsageError(f"--{error}") from None
     print(f"wrote {len(summary.written)} files ({len(summary.rerecorded)} replacing invalid files), "

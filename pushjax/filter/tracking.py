@@ -95,8 +95,8 @@ def simulate_pushes(objects: Sequence[str], pushes: int, seed: int, testbed: Tes
     if not (step >= 1 and abs(step - round(step)) < 1e-9):
         raise ValueError(f"rate_hz: expected {RECORDING_RATE_HZ} Hz divided by a whole number, got {rate_hz}")
     step = round(step)
-    jobs = dataset.plan_pushes("unused", list(objects), ["abs"], pushes, seed=seed, velocities=[velocity],
-                               testbed=testbed)
+    jobs = dataset.plan_pushes("unused", list(objects), ["abs"], pushes,
+                               dataset.RecordingSettings(seed=seed, velocities=(velocity,), testbed=testbed))
     result = []
     for job in jobs:
         recording = dataset.simulate_job(job)

@@ -14,7 +14,8 @@ to ``<workdir>/models/<key>.json`` (a few tens of KiB), and ``results.json``, ``
 assembled again from every record present. A later run with the same work directory skips every model that has a
 record, so the run resumes across sittings and fresh checkouts as long as the records are kept (committed); a
 model interrupted before its record is written is trained again from the start. The dataset is rebuilt from its
-seed when missing.
+seed when missing. Each trained model's parameters go to ``<workdir>/checkpoints/<key>/`` (not committed), from which
+``pushjax.load_model(workdir, model=key)`` loads it to predict; models recorded before the run kept them have none.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import dataclasses
 import datetime
 import json
 import math
+import shutil
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -46,6 +48,8 @@ SIDE_VARIANTS = ("simple", "neural_dyn")
 WIDE_VARIANTS = ("neural", "hybrid")
 """Trained once (seed 0) at the full split with the paper's widths (`pushjax.models.ModelConfig`'s defaults)."""
 SCALE = "cpu_full"
+CHECKPOINTS = "checkpoints"
+"""The work directory's folder of one checkpoint folder per trained model (named by its key)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -126,9 +130,11 @@ def train_config(spec: spec_lib.ExperimentSpec, unit: Unit) -> train_lib.TrainCo
 
 def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Mapping, validation: Mapping,
                test: Mapping, criterion: convergence.Criterion = convergence.CRITERION,
-               log: Callable[[str], None] | None = None, tensorboard_dir: str | Path | None = None) -> dict:
+               log: Callable[[str], None] | None = None, tensorboard_dir: str | Path | None = None,
+               checkpoint_dir: str | Path | None = None) -> dict:
     """Trains and evaluates one model; returns its record. With `tensorboard_dir`, the model's scores go to the
-    TensorBoard run ``<tensorboard_dir>/<unit key>/train`` (restarted with the model)."""
+    TensorBoard run ``<tensorboard_dir>/<unit key>/train`` (restarted with the model); with `checkpoint_dir`, its
+    parameters to a checkpoint there (`pushjax.train.predictor.save_model`, replacing any earlier one)."""
     count = len(train_examples["motion"])
     size = min(unit.size, count)
     (model_spec,) = train_lib.subset_specs(count, (size,), (unit.seed,))
@@ -142,6 +148,9 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Mappin
     finally:
         if tensorboard is not None:
             tensorboard.close()
+    if checkpoint_dir is not None:
+        shutil.rmtree(checkpoint_dir, ignore_errors=True)  # a model killed before its record was written
+        train_lib.predictor.save_model(checkpoint_dir, trained.steps, config.model, model_spec, trained.state)
     clock = time.monotonic()
     metrics = evaluate.evaluate(trained.model, trained.state, test, config.eval_batch_size)
     row = {"model": unit.model, "kind": "trained", "train_split": "train", "test_split": "test",
@@ -196,7 +205,8 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
 
     Args:
       spec: `make_spec`.
-      workdir: the records (``models/``), ``baselines.json`` and ``results.json``.
+      workdir: the records (``models/``), ``baselines.json``, ``results.json`` and the models' checkpoints
+        (``checkpoints/``).
       units: `plan`.
       max_models: train at most this many models in this call (None: all).
       deadline: start no model after this time (UTC).
@@ -228,7 +238,7 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
             log(f"{NAME}: training {unit.key} (budget {criterion.budget(min(unit.size, len(train_examples['motion'])))}"
                 " constant-rate steps)")
             record = train_unit(spec, unit, train_examples, validation, test, criterion, log,
-                                workdir / train_lib.metrics_log.TENSORBOARD_DIR)
+                                workdir / train_lib.metrics_log.TENSORBOARD_DIR, workdir / CHECKPOINTS / unit.key)
             _write_json(workdir / "models" / f"{unit.key}.json", record)
             trained += 1
             row = record["row"]

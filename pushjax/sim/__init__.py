@@ -1,6 +1,6 @@
 """MuJoCo testbed standing in for the MIT Push Dataset: scenes, simulated pushes, effects, recording.
 
-``scene`` builds the MJCF scenes, ``push`` simulates and records single pushes along the MIT protocol of
+``scene`` builds the scenes (``mujoco.MjSpec``), ``push`` simulates and records single pushes along the MIT protocol of
 :mod:`pushjax.mit.protocol`, ``dataset`` records whole data sets in parallel (``experiments/record_pushes.py``)
 in the file layout of :mod:`pushjax.mit.files`, ``effects`` declares the physical and sensor effects and
 ``surfaces`` the friction data and ``testbed`` the testbed profiles (``ideal``, ``realistic``: the physics that the
@@ -9,7 +9,7 @@ quasi-static model.
 """
 
 from pushjax.sim import dataset, effects, push, scene, surfaces, testbed
-from pushjax.sim.dataset import plan_pushes, record_pushes
+from pushjax.sim.dataset import RecordingSettings, plan_pushes, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.push import Recording, Simulator, simulate_push
 from pushjax.sim.scene import build_model, scene_xml, write_scene
@@ -21,6 +21,7 @@ __all__ = [
     "IDEAL",
     "REALISTIC",
     "Recording",
+    "RecordingSettings",
     "SURFACE_NAMES",
     "Simulator",
     "Testbed",

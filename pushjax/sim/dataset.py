@@ -42,7 +42,7 @@ from pushjax.sim import scene
 from pushjax.sim.effects import Effects
 from pushjax.sim.push import Recording, implausible_speed, simulate_push
 from pushjax.sim.surfaces import SURFACE_NAMES, get_surface
-from pushjax.sim.testbed import IDEAL, PushConditions, Testbed, draw_conditions
+from pushjax.sim.testbed import IDEAL, REALISTIC, PushConditions, Testbed, draw_conditions
 
 _MAX_DRAWS_PER_PUSH = 1000
 """Draws after which a push that keeps hitting already drawn file names gives up."""
@@ -67,6 +67,81 @@ MANIFEST_NAME = "pushjax_manifest.json"
 class OutDirConflictError(ValueError):
     """An ``out_dir`` that :func:`record_pushes` must not record into: its manifest holds other settings, the
     manifest is unreadable, or the folder holds push files but no manifest. The message names the folder."""
+
+
+@dataclasses.dataclass(frozen=True)
+class RecordingSettings:
+    """The settings that fix the bytes of every file recorded with them (the push counts, objects and surfaces
+    choose which files).
+
+    Attributes:
+      seed: seed of everything random (an integer >= 0).
+      velocities: pusher velocities to draw from, mm/s (> 0), in draw order.
+      accelerations: pusher accelerations to draw from, mm/s² (>= 0; 0 = constant velocity), in draw order.
+      repeats: files per drawn push; more than 1 adds ``_rep=NNNN`` to the names.
+      effects: effects of every push.
+      declare_effects: write the effects, seed etc. as HDF5 attributes; False writes exactly the three datasets
+        of a real MIT file.
+      support: support mode (``grid`` or ``hull``, :data:`pushjax.sim.scene.SUPPORT_MODES`).
+      testbed: the testbed profile (:mod:`pushjax.sim.testbed`); :data:`~pushjax.sim.testbed.REALISTIC` as in every
+        command and dataset config, :data:`~pushjax.sim.testbed.IDEAL` gives the files recorded before testbeds
+        existed.
+      start_poses: where each push starts, one of :data:`START_POSES` (``fixed``: the MIT protocol).
+
+    Raises:
+      ValueError: an invalid field, naming it.
+    """
+
+    seed: int = 0
+    velocities: tuple[float, ...] = MIT_VELOCITIES
+    accelerations: tuple[float, ...] = (0.0,)
+    repeats: int = 1
+    effects: Effects = Effects()
+    declare_effects: bool = True
+    support: str = "grid"
+    testbed: Testbed = REALISTIC
+    start_poses: str = "fixed"
+
+    def __post_init__(self):
+        for name, value, low in (("repeats", self.repeats, 1), ("seed", self.seed, 0)):
+            if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < low:
+                raise ValueError(f"{name}: expected an integer >= {low}, got {value!r}")
+        if not self.velocities or not all(isinstance(v, (int, float)) and math.isfinite(v) and v > 0
+                                          for v in self.velocities):
+            raise ValueError(f"velocities: expected finite velocities > 0 in mm/s, got {list(self.velocities)}")
+        if not self.accelerations or not all(isinstance(a, (int, float)) and math.isfinite(a) and a >= 0
+                                             for a in self.accelerations):
+            raise ValueError(f"accelerations: expected finite accelerations >= 0 in mm/s², got "
+                             f"{list(self.accelerations)}")
+        if not isinstance(self.effects, Effects):
+            raise ValueError(f"effects: expected an Effects, got {type(self.effects).__name__}")
+        if self.support not in scene.SUPPORT_MODES:
+            raise ValueError(f"support: expected one of {', '.join(scene.SUPPORT_MODES)}, got {self.support!r}")
+        if not isinstance(self.testbed, Testbed):
+            raise ValueError(f"testbed: expected a Testbed, got {type(self.testbed).__name__}")
+        if self.start_poses not in START_POSES:
+            raise ValueError(f"start_poses: expected one of {', '.join(START_POSES)}, got {self.start_poses!r}")
+        object.__setattr__(self, "velocities", tuple(self.velocities))
+        object.__setattr__(self, "accelerations", tuple(self.accelerations))
+
+    def to_dict(self) -> dict:
+        """The settings as JSON values, as the manifest holds them; ``simulator`` adds the MuJoCo version.
+
+        A manifest written before testbeds (or start poses) existed has no ``testbed`` (``start_poses``); it counts
+        as the ideal testbed (fixed starts): :data:`_LEGACY_SETTINGS`.
+        """
+        return {
+            "seed": int(self.seed),
+            "velocities": [float(velocity) for velocity in self.velocities],
+            "accelerations": [float(acceleration) for acceleration in self.accelerations],
+            "repeats": int(self.repeats),
+            "effects": self.effects.to_dict(),
+            "declare_effects": bool(self.declare_effects),
+            "support": self.support,
+            "testbed": self.testbed.to_dict(),
+            "start_poses": self.start_poses,
+            "simulator": f"mujoco {mujoco.__version__}",
+        }
 
 
 @dataclasses.dataclass(frozen=True)
@@ -119,26 +194,18 @@ def plan_pushes(
     objects: Sequence[str],
     surfaces: Sequence[str],
     pushes: int,
-    seed: int = 0,
-    velocities: Sequence[float] = MIT_VELOCITIES,
-    accelerations: Sequence[float] = (0.0,),
-    repeats: int = 1,
-    effects: Effects = Effects(),
-    declare_effects: bool = True,
-    support: str = "grid",
-    testbed: Testbed = IDEAL,
-    start_poses: str = "fixed",
+    settings: RecordingSettings = RecordingSettings(),
 ) -> list[PushJob]:
     """The files to record, in a deterministic order; arguments as in :func:`record_pushes`."""
-    _check_arguments(objects, surfaces, pushes, seed, velocities, accelerations, repeats, effects, support,
-                     start_poses)
-    if not isinstance(testbed, Testbed):
-        raise ValueError(f"testbed: expected a Testbed, got {type(testbed).__name__}")
+    _check_selection(objects, surfaces, pushes)
+    if not isinstance(settings, RecordingSettings):
+        raise ValueError(f"settings: expected a RecordingSettings, got {type(settings).__name__}")
+    seed, effects, support, testbed = settings.seed, settings.effects, settings.support, settings.testbed
     jobs = []
     for obj in objects:
         shape = get_object(obj)
-        grid_size = (len(shape.sides) * len(side_points(shape)) * len(MIT_ANGLES) * len(set(velocities))
-                     * len(set(accelerations)))
+        grid_size = (len(shape.sides) * len(side_points(shape)) * len(MIT_ANGLES) * len(set(settings.velocities))
+                     * len(set(settings.accelerations)))
         if pushes > grid_size:
             raise ValueError(f"pushes: {obj} has only {grid_size} distinct pushes on this grid, asked for {pushes}")
         for surface in surfaces:
@@ -147,17 +214,17 @@ def plan_pushes(
                 key = (seed, _name_key(obj), _name_key(surface), index)
                 rng = np.random.default_rng(key)
                 for _ in range(_MAX_DRAWS_PER_PUSH):
-                    params = sample_push(shape, surface, rng, velocities, accelerations)
+                    params = sample_push(shape, surface, rng, settings.velocities, settings.accelerations)
                     if push_file_name(params) not in taken:
                         break
                 else:
                     raise ValueError(f"pushes: could not draw {pushes} distinct pushes of {obj} on {surface}")
                 taken.add(push_file_name(params))
-                initial_pose = _start_pose(start_poses, key)
-                for repetition in range(repeats):
-                    repeated = dataclasses.replace(params, repetition=repetition if repeats > 1 else None)
+                initial_pose = _start_pose(settings.start_poses, key)
+                for repetition in range(settings.repeats):
+                    repeated = dataclasses.replace(params, repetition=repetition if settings.repeats > 1 else None)
                     attributes = None
-                    if declare_effects:
+                    if settings.declare_effects:
                         attributes = {
                             "pushjax_effects": effects.to_json(),
                             "pushjax_seed": int(seed),
@@ -225,44 +292,25 @@ def record_pushes(
     objects: Sequence[str],
     surfaces: Sequence[str],
     pushes: int,
-    seed: int = 0,
-    velocities: Sequence[float] = MIT_VELOCITIES,
-    accelerations: Sequence[float] = (0.0,),
-    repeats: int = 1,
-    effects: Effects = Effects(),
-    declare_effects: bool = True,
-    support: str = "grid",
-    testbed: Testbed = IDEAL,
+    settings: RecordingSettings = RecordingSettings(),
     workers: int | None = None,
     progress: bool = True,
-    start_poses: str = "fixed",
 ) -> RecordSummary:
     """Records simulated pushes as MIT raw files under ``out_dir/<surface>/<object>/``.
 
     Resumable: files that already exist and read as valid pushes (``pushjax.mit.read_raw_push``) are kept, invalid
     ones are recorded again. ``out_dir/pushjax_manifest.json`` (:data:`MANIFEST_NAME`) records the settings that fix
-    the files' bytes (:func:`recording_settings`); a call whose settings differ from it is refused (see the module
-    docstring).
+    the files' bytes (:meth:`RecordingSettings.to_dict`); a call whose settings differ from it is refused (see the
+    module docstring).
 
     Args:
       out_dir: dataset root; new, empty, or recorded by earlier calls with the same settings.
       objects: object names (``pushjax.geometry.OBJECT_NAMES``).
       surfaces: surface names (``abs``, ``delrin``, ``plywood``, ``pu``).
       pushes: distinct pushes per (object, surface), drawn from the MIT grid.
-      seed: seed of everything random.
-      velocities: pusher velocities to draw from, mm/s (> 0).
-      accelerations: pusher accelerations to draw from, mm/s² (>= 0; 0 = constant velocity).
-      repeats: files per drawn push; more than 1 adds ``_rep=NNNN`` to the names.
-      effects: effects of every push.
-      declare_effects: write the effects, seed etc. as HDF5 attributes; False writes exactly the three datasets
-        of a real MIT file.
-      support: support mode (``grid`` or ``hull``).
-      testbed: the testbed profile (:mod:`pushjax.sim.testbed`; default :data:`~pushjax.sim.testbed.IDEAL`, the
-        files of the ideal testbed are those recorded before testbeds existed; ``record_pushes --testbed`` and the
-        dataset configs default to the realistic profile).
+      settings: the settings that fix the files' bytes (default: the realistic testbed).
       workers: worker processes (default: all cores); 1 records in this process.
       progress: show a tqdm progress bar.
-      start_poses: where each push starts, one of :data:`START_POSES` (default ``fixed``, the MIT protocol).
 
     Returns:
       The :class:`RecordSummary`.
@@ -274,10 +322,8 @@ def record_pushes(
     """
     if workers is not None and (not isinstance(workers, int) or workers < 1):
         raise ValueError(f"workers: expected an integer >= 1, got {workers!r}")
-    jobs = plan_pushes(out_dir, objects, surfaces, pushes, seed, velocities, accelerations, repeats, effects,
-                       declare_effects, support, testbed, start_poses)
-    _claim_out_dir(Path(out_dir), recording_settings(seed, velocities, accelerations, repeats, effects,
-                                                     declare_effects, support, testbed, start_poses))
+    jobs = plan_pushes(out_dir, objects, surfaces, pushes, settings)
+    _claim_out_dir(Path(out_dir), settings.to_dict())
     skipped, todo, invalid = [], [], {}
     for job in jobs:
         if not job.path.exists():
@@ -322,37 +368,6 @@ def recorded_file_problem(job: PushJob) -> str | None:
         return (f"{job.path}: the object moves at {speed * 1000:.0f} mm/s behind a pusher at "
                 f"{job.params.velocity_si * 1000:.0f} mm/s")
     return None
-
-
-def recording_settings(
-    seed: int,
-    velocities: Sequence[float],
-    accelerations: Sequence[float],
-    repeats: int,
-    effects: Effects,
-    declare_effects: bool,
-    support: str,
-    testbed: Testbed = IDEAL,
-    start_poses: str = "fixed",
-) -> dict:
-    """The settings that fix the bytes of every file :func:`record_pushes` writes, as JSON values.
-
-    Arguments as in :func:`record_pushes` (velocities in mm/s, accelerations in mm/s², both in draw order);
-    ``simulator`` adds the MuJoCo version. A manifest written before testbeds (or start poses) existed has no
-    ``testbed`` (``start_poses``); it counts as the ideal testbed (fixed starts): :data:`_LEGACY_SETTINGS`.
-    """
-    return {
-        "seed": int(seed),
-        "velocities": [float(velocity) for velocity in velocities],
-        "accelerations": [float(acceleration) for acceleration in accelerations],
-        "repeats": int(repeats),
-        "effects": effects.to_dict(),
-        "declare_effects": bool(declare_effects),
-        "support": support,
-        "testbed": testbed.to_dict(),
-        "start_poses": start_poses,
-        "simulator": f"mujoco {mujoco.__version__}",
-    }
 
 
 _LEGACY_SETTINGS = {"testbed": IDEAL.to_dict(), "start_poses": "fixed"}
@@ -405,10 +420,7 @@ def _claim_out_dir(out_dir: Path, settings: dict) -> None:
             "record into another folder or use the recorded settings")
 
 
-def _check_arguments(objects, surfaces, pushes, seed, velocities, accelerations, repeats, effects, support,
-                     start_poses):
-    if start_poses not in START_POSES:
-        raise ValueError(f"start_poses: expected one of {', '.join(START_POSES)}, got {start_poses!r}")
+def _check_selection(objects, surfaces, pushes):
     for name, values, known in (("objects", objects, OBJECT_NAMES), ("surfaces", surfaces, SURFACE_NAMES)):
         if isinstance(values, str) or not values:
             raise ValueError(f"{name}: expected a non-empty list of names from {', '.join(known)}, got {values!r}")
@@ -417,18 +429,8 @@ def _check_arguments(objects, surfaces, pushes, seed, velocities, accelerations,
             raise ValueError(f"{name}: unknown {', '.join(map(repr, unknown))}; expected names from {', '.join(known)}")
         if len(set(values)) != len(values):
             raise ValueError(f"{name}: names repeat in {list(values)}")
-    for name, value, low in (("pushes", pushes, 1), ("repeats", repeats, 1), ("seed", seed, 0)):
-        if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < low:
-            raise ValueError(f"{name}: expected an integer >= {low}, got {value!r}")
-    if not velocities or not all(isinstance(v, (int, float)) and math.isfinite(v) and v > 0 for v in velocities):
-        raise ValueError(f"velocities: expected finite velocities > 0 in mm/s, got {list(velocities)}")
-    if not accelerations or not all(isinstance(a, (int, float)) and math.isfinite(a) and a >= 0
-                                    for a in accelerations):
-        raise ValueError(f"accelerations: expected finite accelerations >= 0 in mm/s², got {list(accelerations)}")
-    if not isinstance(effects, Effects):
-        raise ValueError(f"effects: expected an Effects, got {type(effects).__name__}")
-    if support not in scene.SUPPORT_MODES:
-        raise ValueError(f"support: expected one of {', '.join(scene.SUPPORT_MODES)}, got {support!r}")
+    if not isinstance(pushes, (int, np.integer)) or isinstance(pushes, bool) or pushes < 1:
+        raise ValueError(f"pushes: expected an integer >= 1, got {pushes!r}")
 
 
 def _difference(name: str, recorded, requested) -> str:

@@ -39,7 +39,7 @@ from pushjax.train.batching import (
     subset_specs,
 )
 from pushjax.train.configs import TrainConfig, get_config
-from pushjax.train.predictor import Prediction, Predictor, load_model
+from pushjax.train.predictor import Prediction, Predictor, load_model, save_model
 from pushjax.train.train_state import TrainState, create_train_state, make_optimizer, make_train_step
 from pushjax.train.sweep_trainer import SWEEP_MODES, SweepResult, describe_specs, sweep
 
@@ -72,6 +72,7 @@ __all__ = [
     "gather",
     "get_config",
     "load_model",
+    "save_model",
     "make_optimizer",
     "make_train_step",
     "model_fields",

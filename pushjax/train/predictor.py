@@ -26,7 +26,9 @@ from pushjax.geometry import THICKNESS
 from pushjax.models import ERROR_OPTIONS, ModelConfig, PushModel
 from pushjax.render.camera import Camera, project
 from pushjax.train.checkpoint import Checkpointer
-from pushjax.train.sweep_trainer import MODEL_CONFIG_KEY, MODEL_VARIANTS_KEY
+from pushjax.train.batching import ModelSpec
+from pushjax.train.sweep_trainer import MODEL_CONFIG_KEY, MODEL_VARIANTS_KEY, model_metadata
+from pushjax.train.train_state import TrainState
 
 
 @dataclasses.dataclass(frozen=True)
@@ -146,6 +148,11 @@ def _apply(model: PushModel, variables, batch, error_options):
     return model.apply(variables, batch, train=False, error_options=error_options)
 
 
+def _holds_steps(folder: Path) -> bool:
+    """Whether `folder` is a checkpoint folder (orbax steps as numbered subfolders)."""
+    return folder.is_dir() and any(child.name.isdigit() for child in folder.iterdir() if child.is_dir())
+
+
 def find_checkpoints(path: str | os.PathLike) -> Path:
     """The checkpoint folder (orbax steps) at or under `path`: a sweep's work directory (``<path>/checkpoints``),
     the folder itself, or the one sweep under a run's work directory; raises ValueError naming the choices when there
@@ -153,13 +160,26 @@ def find_checkpoints(path: str | os.PathLike) -> Path:
     path = Path(path)
     if not path.is_dir():
         raise ValueError(f"path: {path} is not a folder (a run's or a sweep's work directory, or its checkpoints)")
-    if any(child.name.isdigit() for child in path.iterdir() if child.is_dir()):
+    if _holds_steps(path):
         return path
     found = sorted(folder for folder in path.rglob("checkpoints") if folder.is_dir())
     if len(found) != 1:
         choices = f"choose one of {', '.join(str(folder.parent) for folder in found)}" if found else "found none"
         raise ValueError(f"path: expected one sweep's checkpoints under {path}; {choices}")
     return found[0]
+
+
+def save_model(folder: str | os.PathLike, step: int, model_config: ModelConfig, spec: ModelSpec,
+               state: TrainState) -> None:
+    """Writes one trained model as a checkpoint that `load_model` reads: its parameters and batch statistics (a model
+    axis of one, as in a sweep's checkpoint) at `step` in `folder`, with `model_metadata` beside them."""
+    variables = {"params": state.params, **({"batch_stats": state.batch_stats} if state.batch_stats else {})}
+    checkpointer = Checkpointer(folder)
+    try:
+        checkpointer.save(step, jax.tree.map(lambda leaf: np.asarray(leaf)[None], variables),
+                          model_metadata(model_config, [spec]))
+    finally:
+        checkpointer.close()
 
 
 def model_config_from_json(config: Mapping) -> ModelConfig:
@@ -176,9 +196,11 @@ def load_model(path: str | os.PathLike, model: int | str = 0, step: int | None =
 
     Args:
       path: a sweep's work directory, its ``checkpoints`` folder, or a run's work directory holding one sweep
-        (`pushjax.paper.runner`; with several, the error lists them).
+        (`pushjax.paper.runner`; with several, the error lists them); or a work directory whose ``checkpoints`` folder
+        holds one checkpoint folder per model (`pushjax.paper.full_run`, `save_model`).
       model: which of the sweep's models: its index (negative from the end: -1 is the largest size's last seed), or
-        its name (e.g. ``"size=200/seed=0"``).
+        its name (e.g. ``"size=200/seed=0"``); with one folder per model, the folder's name (e.g.
+        ``"hybrid_2500_seed0"``).
       step: the checkpoint's step; None: the newest.
 
     Raises:
@@ -186,6 +208,12 @@ def load_model(path: str | os.PathLike, model: int | str = 0, step: int | None =
         unknown model or step, the ``neural_dyn`` variant, which predicts from the true state and not from images).
     """
     folder = find_checkpoints(path)
+    per_model = sorted(child.name for child in folder.iterdir() if _holds_steps(child))
+    if per_model and not _holds_steps(folder):
+        if model not in per_model:
+            raise ValueError(f"model: {folder} holds one checkpoint folder per model; expected one of {per_model}, got "
+                             f"{model!r}")
+        folder, model = folder / model, 0
     checkpointer = Checkpointer(folder, read_only=True)
     try:
         steps = checkpointer.all_steps()

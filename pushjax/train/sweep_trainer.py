@@ -68,6 +68,21 @@ MODEL_VARIANTS_KEY = "model_variants"
 """The checkpoint metadata's key of each model's variant (they differ in a sweep that mixes the error variants)."""
 
 
+def model_metadata(model_config: ModelConfig, specs: Sequence[ModelSpec]) -> dict:
+    """What a checkpoint of `specs`' models holds beside their parameters: their identity (names, seeds, training
+    subsets, variant), their `ModelConfig` and each one's variant, from which `pushjax.train.predictor.load_model`
+    rebuilds them."""
+    identity = {
+        "names": [spec.name for spec in specs],
+        "seeds": [spec.seed for spec in specs],
+        "subset_sizes": [len(spec.train_indices) for spec in specs],
+        "subset_checksums": [int(np.asarray(spec.train_indices, np.int64).sum()) for spec in specs],
+        "variant": model_config.variant,
+    }
+    return {"identity": identity, MODEL_CONFIG_KEY: dataclasses.asdict(model_config),
+            MODEL_VARIANTS_KEY: [spec.variant or model_config.variant for spec in specs]}
+
+
 def _error_options(config: ModelConfig, specs: Sequence[ModelSpec]) -> jax.Array | None:
     """[K, 2] per-model error-term flags, or None when no spec overrides the variant."""
     if all(spec.variant is None for spec in specs):
@@ -316,15 +331,8 @@ def sweep(
     start = 0
     checkpointer = log = tensorboard = None
     names = [spec.name for spec in specs]
-    identity = {
-        "names": names,
-        "seeds": [spec.seed for spec in specs],
-        "subset_sizes": [len(spec.train_indices) for spec in specs],
-        "subset_checksums": [int(np.asarray(spec.train_indices, np.int64).sum()) for spec in specs],
-        "variant": model_config.variant,
-    }
-    checkpoint_metadata = {"identity": identity, MODEL_CONFIG_KEY: dataclasses.asdict(model_config),
-                           MODEL_VARIANTS_KEY: [spec.variant or model_config.variant for spec in specs]}
+    checkpoint_metadata = model_metadata(model_config, specs)
+    identity = checkpoint_metadata["identity"]
     if workdir is not None:
         workdir = Path(workdir)
         workdir.mkdir(parents=True, exist_ok=True)

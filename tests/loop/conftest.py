@@ -9,9 +9,10 @@ import pytest
 from tests.conftest import _shared_folder, once_across_workers
 
 from pushjax.loop import close_loop
-from pushjax.sim.dataset import record_pushes
+from pushjax.sim.dataset import RecordingSettings, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
+from pushjax.sim.testbed import IDEAL
 
 
 @dataclasses.dataclass(frozen=True)
@@ -67,9 +68,10 @@ def record(tmp_path_factory):
 
     def get(name):
         root = shared / f"loop_pushes_{name}"
-        return once_across_workers(root, lambda: record_pushes(
-            root, ["rect1"], ["pu"], CASES[name].pushes, seed=1, velocities=(20.0,), effects=CASES[name].effects,
-            declare_effects=False, workers=1, progress=False))
+        settings = RecordingSettings(seed=1, velocities=(20.0,), effects=CASES[name].effects, declare_effects=False,
+                                     testbed=IDEAL)
+        return once_across_workers(root, lambda: record_pushes(root, ["rect1"], ["pu"], CASES[name].pushes, settings,
+                                                               workers=1, progress=False))
 
     return get
 

@@ -2,11 +2,15 @@
 
 import json
 import shutil
+import types
 
 import pytest
 from absl import app
 
-from pushjax.paper import findings, full_run
+from pushjax import train as train_lib
+from pushjax.paper import findings, full_run, runner
+from pushjax.train import evaluate
+from pushjax.train.predictor import load_model
 from tests.paper.conftest import RUNS, SMOKE, run_binary
 
 
@@ -68,3 +72,19 @@ def test_bad_criterion_and_deadline(tmp_path):
         run_binary("data_efficiency_full", f"--workdir={tmp_path}", "--criterion=window=x")
     with pytest.raises(app.UsageError, match="--deadline"):
         run_binary("data_efficiency_full", f"--workdir={tmp_path}", "--deadline=soon")
+
+
+def test_a_recorded_model_loads_from_the_run_and_scores_as_recorded(smoke_results, smoke_data):
+    workdir = smoke_results("data_efficiency_full")
+    record = json.loads((workdir / "models" / "hybrid_80_seed0.json").read_text())
+    predictor = load_model(workdir, model="hybrid_80_seed0")
+    assert predictor.variant == "hybrid" and predictor.name == "size=80/seed=0"
+    assert predictor.checkpoint == (workdir / full_run.CHECKPOINTS / "hybrid_80_seed0", record["row"]["steps"])
+    spec = full_run.make_spec(smoke_data("data_efficiency"), sizes=(40, 80), seeds=(0,), scale="smoke", build=False)
+    test = train_lib.examples_from_source(runner.load_splits(spec, spec.dataset, False)["test"], spec.example_fields())
+    state = types.SimpleNamespace(params=predictor.variables["params"], batch_stats=predictor.variables["batch_stats"])
+    scores = evaluate.evaluate(predictor.model, state, test)
+    for key in ("trans_percent", "rot_percent"):
+        assert scores[key] == pytest.approx(record["row"][key], rel=1e-5)
+    with pytest.raises(ValueError, match=r"model: .* one checkpoint folder per model; expected one of \[.*'neural_40_seed0'"):
+        load_model(workdir, model="hybrid_99_seed0")

@@ -262,8 +262,8 @@ def test_motion_capture_noise_jitter_and_drops():
 
 # Recording: deterministic, resumable, readable; the ideal profile is unchanged.
 
-REALISTIC_RUN = dict(objects=["rect1"], surfaces=["abs"], pushes=2, seed=7, velocities=(20.0, 200.0),
-                     testbed=REALISTIC, progress=False)
+SELECTION = dict(objects=["rect1"], surfaces=["abs"], pushes=2, progress=False)
+REALISTIC_RUN = dataset.RecordingSettings(seed=7, velocities=(20.0, 200.0), testbed=REALISTIC)
 
 
 def files(root):
@@ -271,10 +271,11 @@ def files(root):
 
 
 def test_realistic_recording_is_deterministic_readable_and_refuses_other_testbeds(tmp_path):
-    first = dataset.record_pushes(tmp_path / "first", workers=1, **REALISTIC_RUN)
-    dataset.record_pushes(tmp_path / "second", workers=2, **REALISTIC_RUN)
+    first = dataset.record_pushes(tmp_path / "first", settings=REALISTIC_RUN, workers=1, **SELECTION)
+    dataset.record_pushes(tmp_path / "second", settings=REALISTIC_RUN, workers=2, **SELECTION)
     assert files(tmp_path / "first") == files(tmp_path / "second")
-    ideal = dataset.record_pushes(tmp_path / "ideal", workers=1, **{**REALISTIC_RUN, "testbed": IDEAL})
+    ideal = dataset.record_pushes(tmp_path / "ideal", settings=dataclasses.replace(REALISTIC_RUN, testbed=IDEAL),
+                                  workers=1, **SELECTION)
     assert [path.name for path in ideal.written] == [path.name for path in first.written]
     assert all(files(tmp_path / "first")[name] != content for name, content in files(tmp_path / "ideal").items())
     for path in ideal.written:
@@ -295,31 +296,34 @@ def test_realistic_recording_is_deterministic_readable_and_refuses_other_testbed
     before = files(tmp_path / "first")
     other = dataclasses.replace(REALISTIC, drop_rate=0.0)
     with pytest.raises(dataset.OutDirConflictError, match=r" testbed \(drop_rate 0.01 there, 0.0 now\)"):
-        dataset.record_pushes(tmp_path / "first", workers=1, **{**REALISTIC_RUN, "testbed": other})
+        dataset.record_pushes(tmp_path / "first", settings=dataclasses.replace(REALISTIC_RUN, testbed=other), workers=1,
+                              **SELECTION)
     with pytest.raises(dataset.OutDirConflictError, match=" testbed "):
-        dataset.record_pushes(tmp_path / "ideal", workers=1, **REALISTIC_RUN)
+        dataset.record_pushes(tmp_path / "ideal", settings=REALISTIC_RUN, workers=1, **SELECTION)
     assert files(tmp_path / "first") == before
 
 
 def test_a_manifest_without_testbed_counts_as_ideal(tmp_path):
-    run = dict(objects=["rect1"], surfaces=["abs"], pushes=1, seed=1, velocities=(50.0,), workers=1, progress=False)
-    dataset.record_pushes(tmp_path, **run)
+    run = dict(objects=["rect1"], surfaces=["abs"], pushes=1, workers=1, progress=False)
+    ideal = dataset.RecordingSettings(seed=1, velocities=(50.0,), testbed=IDEAL)
+    dataset.record_pushes(tmp_path, settings=ideal, **run)
     manifest = tmp_path / dataset.MANIFEST_NAME
     content = json.loads(manifest.read_text())
     del content["settings"]["testbed"]
     manifest.write_text(json.dumps(content))
-    assert len(dataset.record_pushes(tmp_path, **run).skipped) == 1
+    assert len(dataset.record_pushes(tmp_path, settings=ideal, **run).skipped) == 1
     with pytest.raises(dataset.OutDirConflictError, match=" testbed "):
-        dataset.record_pushes(tmp_path, **run, testbed=REALISTIC)
+        dataset.record_pushes(tmp_path, settings=dataclasses.replace(ideal, testbed=REALISTIC), **run)
 
 
 def test_lynch_model_runs_on_realistic_files_and_errs_more(tmp_path):
     """Windows of 0.5 s from recorded files, annotated and predicted as the quasi-static baseline does: finite on
     realistic files, and further from the recorded motion than on ideal files of the same pushes."""
-    run = dict(objects=["rect1"], surfaces=["abs"], pushes=3, seed=2, velocities=(20.0,), workers=1, progress=False)
+    run = dict(objects=["rect1"], surfaces=["abs"], pushes=3, workers=1, progress=False)
     errors = {}
     for name, profile in (("ideal", IDEAL), ("realistic", REALISTIC)):
-        summary = dataset.record_pushes(tmp_path / name, testbed=profile, **run)
+        settings = dataset.RecordingSettings(seed=2, velocities=(20.0,), testbed=profile)
+        summary = dataset.record_pushes(tmp_path / name, settings=settings, **run)
         shape = get_object("rect1")
         simulated, predicted = [], []
         for path in summary.written:
