@@ -369,13 +369,24 @@ def _shape_lines(shape: shape_lib.LimitSurfaceShape, fitted: dict | None) -> lis
                   f"{rim['std']:.2g}."]
         motion = (fitted or {}).get("rim")
         if motion is not None and motion["std"]:
-            weights = np.array([1 / motion["std"] ** 2, 1 / rim["std"] ** 2])
-            value = float(np.dot(weights, [motion["value"], rim["value"]]) / weights.sum())
-            std = float(1 / np.sqrt(weights.sum()))
-            lines[-1] += (f" From the motion fit: {motion['value']:.3g} ± {motion['std']:.2g}; both together: "
-                          f"{value:.3g} ± {std:.2g}, an interval {motion['std'] / std:.2g} times narrower than the "
-                          "motion's alone.")
+            lines[-1] += f" From the motion fit: {motion['value']:.3g} ± {motion['std']:.2g}; " + _combined_rim(
+                motion, rim)
     return lines
+
+
+def _combined_rim(motion: dict, force: dict, alpha: float = 0.05) -> str:
+    """The motion fit's and the force data's rim together, or why they are not combined: two measurements of one
+    pressure must agree before an inverse-variance mean of them means anything."""
+    z = (motion["value"] - force["value"]) / math.hypot(motion["std"], force["std"])
+    p_value = math.erfc(abs(z) / math.sqrt(2))
+    if p_value <= alpha:
+        return (f"the two disagree (z = {z:.2g}, p = {p_value:.2g}), so the motion fit's rim absorbs something the "
+                "force sensor does not see, and they are not combined.")
+    weights = np.array([1 / motion["std"] ** 2, 1 / force["std"] ** 2])
+    value = float(np.dot(weights, [motion["value"], force["value"]]) / weights.sum())
+    std = float(1 / np.sqrt(weights.sum()))
+    return (f"they agree (z = {z:.2g}); both together: {value:.3g} ± {std:.2g}, an interval {motion['std'] / std:.2g} "
+            "times narrower than the motion's alone.")
 
 
 def _uncertainty_row(label: str, scores: dict) -> str:

@@ -121,6 +121,11 @@ def test_the_force_data_narrows_the_motion_fits_rim():
     details = dataclasses.replace(result.details, selected_params={
         **result.details.selected_params, "limit_surface": {"rim": {"value": -1.0, "std": 0.25}}})
     text = report_lib.markdown(dataclasses.replace(result, details=details))
-    # Inverse-variance weights 16 and 64: (-16 - 32) / 80 = -0.6 with standard error 1 / sqrt(80) = 0.11.
-    assert ("From the motion fit: -1 ± 0.25; both together: -0.6 ± 0.11, an interval 2.2 times narrower than the "
-            "motion's alone.") in text
+    # z = -0.5 / 0.28 = -1.8: they agree. Inverse-variance weights 16 and 64: (-16 - 32) / 80 = -0.6 with standard
+    # error 1 / sqrt(80) = 0.11.
+    assert ("From the motion fit: -1 ± 0.25; they agree (z = -1.8); both together: -0.6 ± 0.11, an interval 2.2 times "
+            "narrower than the motion's alone.") in text
+    details = dataclasses.replace(result.details, selected_params={
+        **result.details.selected_params, "limit_surface": {"rim": {"value": 0.5, "std": 0.25}}})
+    assert ("From the motion fit: 0.5 ± 0.25; the two disagree (z = 3.6, p = 0.00035), so the motion fit's rim "
+            "absorbs something") in report_lib.markdown(dataclasses.replace(result, details=details))
