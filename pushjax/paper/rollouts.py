@@ -342,7 +342,8 @@ def horizon_rows(model: str, test_split: str, sequences: Sequence[PushSequence],
 
 
 def trained_predictors(outcome: RunOutcome) -> list[tuple[str, int, Predictor]]:
-    """(variant, seed, predictor) of every trained model of the run that `LEARNED` names."""
+    """(variant, seed, predictor) of every trained model of the run that `LEARNED` names (built from the run's own
+    state, so the predictor's ``checkpoint`` names no folder, only the step)."""
     found = []
     for sweep in outcome.sweeps:
         result = sweep.result
