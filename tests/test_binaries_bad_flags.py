@@ -19,8 +19,8 @@ CASE_TIMEOUT_S = 60
 PARALLEL = 3
 
 LIBRARIES = ("experiments, pushjax.data, pushjax.loop, pushjax.paper.findings, pushjax.paper.figures, "
-             "pushjax.paper.runner, pushjax.paper.spec, pushjax.paper.tables, pushjax.paper.visualize, "
-             "pushjax.physics.demo, pushjax.sim.dataset, pushjax.control.push_to_goal")
+             "pushjax.paper.rollouts, pushjax.paper.runner, pushjax.paper.spec, pushjax.paper.tables, "
+             "pushjax.paper.visualize, pushjax.physics.demo, pushjax.sim.dataset, pushjax.control.push_to_goal")
 """What the binaries import, bar the binaries themselves (each defines flags): a server imports it once and forks."""
 
 # The server: imports the libraries (not the binaries, which define the flags), then forks one child per case.
@@ -85,7 +85,8 @@ while running:
 json.dump([codes[index] for index in range(len(cases))], sys.stdout)
 """
 
-EXPERIMENTS = ("data_efficiency", "new_pushes", "velocities", "objects", "error_variants", "viewpoint", "visualize")
+EXPERIMENTS = ("data_efficiency", "new_pushes", "velocities", "objects", "error_variants", "viewpoint", "visualize",
+               "rollouts")
 # Each case has its own {tmp}: a fresh folder; {file}: a regular file; {empty}: an empty folder (no dataset, no
 # pushes, no results); and all share {read_only}: a folder this process cannot write in.
 RUN = ("--scale=smoke", "--workdir={tmp}/work", "--data_dir={empty}", "--nobuild")
@@ -132,6 +133,10 @@ CASES = [
     *[(binary, [*RUN], "--build") for binary in EXPERIMENTS[1:]],
     *[(binary, [*RUN, "--workdir={file}/work"], "--workdir") for binary in EXPERIMENTS[1:]],
     *[(binary, [*RUN, "--sizes=0"], "--sizes") for binary in EXPERIMENTS[1:]],
+    # rollouts: its own flag and the variants it can roll out.
+    ("rollouts", [*RUN, "--test_splits=test_7"], "--test_splits"),
+    ("rollouts", [*RUN, "--test_splits=test_20,test_20"], "--test_splits"),
+    ("rollouts", [*RUN, "--variants=simple"], "--variants"),
     # train: the shared flags and its own.
     ("train", [*RUN, "--experiment=bogus"], "--experiment"),
     ("train", [*RUN, "--variant=transformer"], "--variant"),

@@ -214,6 +214,13 @@ def _choose_windows(push: Push, obj: str, horizon_samples: int, config: DatasetC
     return candidates[np.sort(chosen)]
 
 
+def pusher_friction(push: Push) -> float:
+    """The pusher-object friction of a recorded push: the file's ``pushjax_pusher_friction``, else the testbed's."""
+    if "pushjax_pusher_friction" in push.attributes:
+        return float(push.attributes["pushjax_pusher_friction"])
+    return scene.pusher_friction()
+
+
 def sequence_examples(push: Push, config: DatasetConfig, renderer: DepthRenderer, sequence_id: int,
                       rng: np.random.Generator) -> dict[str, np.ndarray]:
     """All examples of one push sequence, stacked.
@@ -275,10 +282,7 @@ def sequence_examples(push: Push, config: DatasetConfig, renderer: DepthRenderer
     com1 = com0 + motion[:, :2]
 
     l = _limit_surface_ratio(obj)
-    if "pushjax_pusher_friction" in push.attributes:
-        mu = float(push.attributes["pushjax_pusher_friction"])
-    else:
-        mu = scene.pusher_friction()
+    mu = pusher_friction(push)
     push_velocity, _ = lynch.effective_push_velocity(
         contact.contact_rel_com, contact.normal, contact.action_from_contact, l, mu)
 

@@ -72,6 +72,7 @@ SETUPS = {setup.name: setup for setup in (
     Setup("error_variants", "data_efficiency", ("hybrid", *ERROR_OPTIONS, *BASELINES), sizes=_PAPER_SIZES,
           l_scales=(1.0, 1.5, 3.0), l_scaled_models=("physics", "hybrid", "error")),
     Setup("viewpoint", "viewpoint", ("hybrid", *BASELINES)),
+    Setup("rollouts", "velocities", ("neural", "hybrid", "error", *BASELINES), ("train_20",), _VELOCITY_TESTS),
     Setup("visualize", "data_efficiency", ("neural", "hybrid", "simple", "error"), test_experiment="repeated",
           test_fields=("scene_transform",)),
 )}

@@ -11,7 +11,7 @@ from pushjax.train import configs as train_configs
 
 def test_every_binary_has_a_setup_whose_models_are_known():
     assert set(spec_lib.SETUPS) == {"data_efficiency", "new_pushes", "velocities", "objects", "error_variants",
-                                    "viewpoint", "visualize", "error_velocities"}
+                                    "viewpoint", "visualize", "error_velocities", "rollouts"}
     for setup in spec_lib.SETUPS.values():
         assert spec_lib.parse_models(setup.models) == setup.models
 
