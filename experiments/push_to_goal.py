@@ -84,7 +84,7 @@ def main(argv):
                                   testbed=testbed, effects=Effects.parse(_EFFECTS.value))
     results = push_to_goal.run(_WORKDIR.value, _OBJECTS.value or scale["objects"], _GOALS.value or scale["goals"],
                                _MODELS.value, _PLANNERS.value or scale["planners"], _SEED.value, loop,
-                               _EFFECT_PARAMS.value)
+                               _EFFECT_PARAMS.value, scale["controller"])
     results["settings"]["scale"] = _SCALE.value
     paths = report.write(results, _WORKDIR.value)
     print(paths[1].read_text())

@@ -15,13 +15,18 @@ SHARED = pathlib.Path(__file__).resolve().parents[1].parent / "shared"
 def pytest_configure(config):
     """One persistent XLA compilation cache for every pytest-xdist worker (in pytest's cache folder), set before
     anything compiles: the loop's data sets compile the same fitting programs, the exact limit surface's in 10-20 s
-    each, and without the cache every data set compiles them again."""
+    each, and without the cache every data set compiles them again. The tests' subprocesses (binaries, notebook
+    kernels) get it through the environment, e.g. ``experiments.push_to_goal --scale=smoke`` the controller programs
+    that tests/control/test_closed_loop.py compiles."""
     if getattr(config, "cache", None) is None:
         return
     import jax
 
-    jax.config.update("jax_compilation_cache_dir", str(config.cache.mkdir("xla_compilation_cache")))
-    jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
+    cache = os.environ.setdefault("JAX_COMPILATION_CACHE_DIR", str(config.cache.mkdir("xla_compilation_cache")))
+    os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "1")
+    jax.config.update("jax_compilation_cache_dir", cache)
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", float(os.environ[
+        "JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS"]))
 
 
 @pytest.fixture(scope="session")

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import tqdm
 
-from pushjax.control import closed_loop, goals, mpc, report
+from pushjax.control import closed_loop, goals, gradient, mpc, report
 from pushjax.control.model import make_model
 from pushjax.geometry.objects import OBJECT_NAMES
 from pushjax.physics import effects as effects_lib
@@ -29,11 +29,16 @@ from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
 __all__ = ["SCALES", "model_effects", "parse_effect_params", "run"]
 
 SCALES = {
-    "smoke": {"objects": ("rect1",), "goals": 2, "planners": ("gradient",), "max_time": 30.0},
-    "cpu": {"objects": OBJECT_NAMES, "goals": 2, "planners": ("gradient", "sampling"), "max_time": 60.0},
-    "full": {"objects": OBJECT_NAMES, "goals": 10, "planners": ("gradient", "sampling"), "max_time": 60.0},
+    "smoke": {"objects": ("rect1",), "goals": 2, "planners": ("gradient",), "max_time": 30.0,
+              "controller": mpc.ControllerConfig(horizon=8, gradient=gradient.GradientConfig(iterations=15),
+                                                 candidates=16)},
+    "cpu": {"objects": OBJECT_NAMES, "goals": 2, "planners": ("gradient", "sampling"), "max_time": 60.0,
+            "controller": mpc.ControllerConfig()},
+    "full": {"objects": OBJECT_NAMES, "goals": 10, "planners": ("gradient", "sampling"), "max_time": 60.0,
+             "controller": mpc.ControllerConfig()},
 }
-"""Objects, goals per object, planners and simulated seconds per episode of each scale."""
+"""Objects, goals per object, planners, simulated seconds per episode and controller settings of each scale (smoke:
+a shorter horizon, fewer planner iterations and contact candidates, which compile and plan faster)."""
 TRAJECTORY_STRIDE = 5
 """Control periods between the poses kept for the figure."""
 

@@ -20,6 +20,7 @@ One model per call: the unit of work of a resumable run whose finished models ar
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -29,7 +30,7 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 
-from pushjax.models import PushModel
+from pushjax.models import ModelConfig, PushModel
 from pushjax.train.batching import Examples, ModelSpec, batch_indices, gather, model_fields
 from pushjax.train.configs import TrainConfig
 from pushjax.train.evaluate import error_metrics, predict
@@ -133,6 +134,15 @@ def _with_learning_rate(state: TrainState, value: float) -> TrainState:
     return state.replace(opt_state=opt_state._replace(hyperparams=hyperparams))
 
 
+@functools.lru_cache(maxsize=16)
+def _compiled_step(model_config: ModelConfig, physics: Callable | None, learning_rate: float, weight_decay: float):
+    """(model, optimiser, jitted train step) of `train_until_converged`: cached, so that the models of a run that
+    share an architecture (e.g. one variant at several training-set sizes) compile their step once."""
+    model = PushModel(model_config) if physics is None else PushModel(model_config, physics)
+    optimizer = optax.inject_hyperparams(optax.adam)(learning_rate=learning_rate)
+    return model, optimizer, jax.jit(make_train_step(model, optimizer, weight_decay))
+
+
 def train_until_converged(
     train_config: TrainConfig, examples: Examples, spec: ModelSpec, validation: Examples,
     criterion: Criterion = CRITERION, *, physics: Callable | None = None,
@@ -153,8 +163,8 @@ def train_until_converged(
         score (``validation/trans_percent``, ``validation/rot_percent``, ``validation/score``), the training loss and
         the steps per second of the constant phase, or None.
     """
-    model = PushModel(train_config.model) if physics is None else PushModel(train_config.model, physics)
-    optimizer = optax.inject_hyperparams(optax.adam)(learning_rate=train_config.learning_rate)
+    model, optimizer, step_fn = _compiled_step(train_config.model, physics, train_config.learning_rate,
+                                               train_config.weight_decay)
     fields = model_fields(train_config.model)
     size = len(spec.train_indices)
 
@@ -163,7 +173,6 @@ def train_until_converged(
 
     state = create_train_state(model, optimizer, batch_at(0), spec.seed)
     state = _with_learning_rate(state, train_config.learning_rate)
-    step_fn = jax.jit(make_train_step(model, optimizer, train_config.weight_decay))
     budget = criterion.budget(size)
     scores: list[float] = []
     history: list[tuple[int, float, float]] = []

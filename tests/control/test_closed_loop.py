@@ -6,10 +6,11 @@ import math
 import numpy as np
 import pytest
 
-from pushjax.control import closed_loop, gradient, goals, model, mpc
+from pushjax.control import closed_loop, goals, model, push_to_goal
 from pushjax.sim.testbed import REALISTIC
 
-CONFIG = mpc.ControllerConfig(horizon=8, gradient=gradient.GradientConfig(iterations=15), candidates=16)
+CONFIG = push_to_goal.SCALES["smoke"]["controller"]
+"""The smoke run's controller (a short horizon: its programs compile faster, once for both)."""
 
 
 def test_waypoint_targets_keep_the_step_and_the_multiple():

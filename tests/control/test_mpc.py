@@ -6,9 +6,9 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from pushjax.control import cost, gradient, model, mpc
+from pushjax.control import cost, model, mpc, push_to_goal
 
-CONFIG = mpc.ControllerConfig(horizon=8, gradient=gradient.GradientConfig(iterations=15), candidates=16)
+CONFIG = push_to_goal.SCALES["smoke"]["controller"]
 
 
 @pytest.mark.parametrize("changes, message", [

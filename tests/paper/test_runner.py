@@ -23,13 +23,14 @@ def test_load_splits_says_which_dataset_it_reused(smoke_data, caplog):
 
 
 def test_load_splits_says_where_it_built_a_dataset(smoke_data, tmp_path, caplog):
-    # The suite's simulated pushes in the raw cache, so that the build only renders and writes the examples.
-    shutil.copytree(smoke_data("objects") / RAW_DIR_NAME, tmp_path / RAW_DIR_NAME)
-    spec = spec_lib.make_spec(spec_lib.SETUPS["objects"], "smoke", data_dir=tmp_path)
+    # The smallest smoke dataset (visualize's 24 test examples), its simulated push in the suite's raw cache, so that
+    # the build only renders and writes the examples.
+    shutil.copytree(smoke_data("repeated") / RAW_DIR_NAME, tmp_path / RAW_DIR_NAME)
+    spec = spec_lib.make_spec(spec_lib.SETUPS["visualize"], "smoke", data_dir=tmp_path)
     with caplog.at_level(logging.INFO, logger="absl"):
-        runner.load_splits(spec, spec.dataset, progress=False)
+        runner.load_splits(spec, spec.test_dataset, progress=False)
     [message] = [record.getMessage() for record in caplog.records if record.getMessage().startswith("dataset push_effects")]
-    assert message.startswith("dataset push_effects/objects_smoke version 3.0.0: built in ")
+    assert message.startswith("dataset push_effects/repeated_smoke version 3.0.0: built in ")
     assert str(tmp_path) in message
 
 

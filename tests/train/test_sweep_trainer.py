@@ -51,23 +51,23 @@ class Killed(Exception):
 
 @pytest.mark.parametrize("mode", ["vmap", "sequential"])
 def test_killed_training_resumes_to_the_uninterrupted_parameters(mode, examples, tmp_path):
-    config = _config("hybrid", num_steps=30, checkpoint_every=10, log_every=5)
+    config = _config("hybrid", num_steps=12, checkpoint_every=4, log_every=2)
     specs = train.subset_specs(256, [30, 100], [4])
     uninterrupted = train.sweep(config, examples, specs, tmp_path / "full", mode=mode, progress=False)
 
-    def kill_at_step_23(step, metrics):
-        if step == 23:
+    def kill_at_step_9(step, metrics):
+        if step == 9:
             raise Killed
 
     with pytest.raises(Killed):
         train.sweep(config, examples, specs, tmp_path / "killed", mode=mode, progress=False,
-                    step_callback=kill_at_step_23)
+                    step_callback=kill_at_step_9)
     resumed_steps = []
     resumed = train.sweep(
         config, examples, specs, tmp_path / "killed", mode=mode, progress=False,
         step_callback=lambda step, metrics: resumed_steps.append(step),
     )
-    assert resumed_steps[0] == 21  # restarted after the checkpoint at step 20
+    assert resumed_steps[0] == 9  # restarted after the checkpoint at step 8
     jax.tree.map(np.testing.assert_array_equal, _params(resumed), _params(uninterrupted))
     jax.tree.map(
         np.testing.assert_array_equal, jax.tree.map(np.asarray, resumed.state.batch_stats),
@@ -75,8 +75,8 @@ def test_killed_training_resumes_to_the_uninterrupted_parameters(mode, examples,
     )
     with (tmp_path / "killed" / "metrics.csv").open() as file:
         steps = [int(row["step"]) for row in csv.DictReader(file)]
-    assert steps == [step for step in range(5, 31, 5) for _ in specs]
-    np.testing.assert_array_equal(resumed.steps_trained, [30, 30])
+    assert steps == [step for step in range(2, 13, 2) for _ in specs]
+    np.testing.assert_array_equal(resumed.steps_trained, [12, 12])
 
     with pytest.raises(ValueError, match="different models"):
         train.sweep(config, examples, train.subset_specs(256, [30], [5]), tmp_path / "killed", progress=False)
