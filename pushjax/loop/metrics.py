@@ -257,7 +257,8 @@ class RandomEffects:
       tau: the between-group standard deviation.
       mean, mean_std: the shared value (weights ``1 / (std^2 + tau^2)``) and its standard error.
       shrunk: [G] each group's value shrunk towards ``mean`` by ``tau^2 / (tau^2 + std^2)`` (empirical Bayes).
-      shrunk_std: [G] their standard errors (the share of each group's own error that shrinkage keeps).
+      shrunk_std: [G] their standard errors: the share of each group's own error that shrinkage keeps, plus the
+        shared value's error carried by the share it borrows.
     """
 
     fixed_mean: float
@@ -282,7 +283,8 @@ def random_effects(value: np.ndarray, std: np.ndarray) -> RandomEffects:
     keep = tau_squared / (tau_squared + variance)
     return RandomEffects(fixed_mean=fixed_mean, q=q, p_value=float(stats.chi2.sf(q, len(value) - 1)),
                          tau=float(np.sqrt(tau_squared)), mean=mean, mean_std=float(np.sqrt(1.0 / np.sum(random_weight))),
-                         shrunk=mean + keep * (value - mean), shrunk_std=np.sqrt(keep * variance))
+                         shrunk=mean + keep * (value - mean),
+                         shrunk_std=np.sqrt(keep * variance + (1.0 - keep) ** 2 / np.sum(random_weight)))
 
 
 COVERAGE_LEVELS = (0.68, 0.95)

@@ -67,6 +67,8 @@ def test_random_effects_pool_agreeing_groups_and_shrink_an_imprecise_one():
     np.testing.assert_allclose(spread.shrunk[:2], [1.0, 2.0], atol=1e-3)
     assert abs(spread.shrunk[2] - spread.mean) < 0.2 * abs(5.0 - spread.mean)
     assert np.all(spread.shrunk_std <= np.array([0.01, 0.01, 3.0]))
+    # Agreeing groups borrow everything: each keeps the shared value's standard error, not zero.
+    np.testing.assert_allclose(agreeing.shrunk_std, agreeing.mean_std)
 
 
 def test_holm_steps_down_from_the_smallest_p_value():
