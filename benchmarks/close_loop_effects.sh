@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Per-effect table of the closed loop: record each testbed case with its effect undeclared, run
+# Per-effect table of the closed loop: record each case on the ideal testbed (no unmodelled physics but the case's
+# effect, as the loop tests' data sets) with its effect undeclared, run
 # `experiments.close_loop` on it, print baseline / after (held-out trans % + rot % of the zero
 # baseline), the cut, the selected effects, the test split's noise floor, `explained` and the fallback's error.
 #   bash benchmarks/close_loop_effects.sh [WORK_DIR]     (run with the project's venv active)
@@ -21,7 +22,7 @@ echo "| case | baseline | after | cut | selected | noise floor | explained | fal
 echo "|---|---:|---:|---:|---|---:|---|---:|"
 for name in clean com_offset pressure anisotropy table_tilt pusher_friction tracking_bias tracking_yaw_bias; do
   "$python" -m experiments.record_pushes --out_dir="$work/data/$name" --objects=rect1 --surfaces=pu \
-    --velocities=20 --pushes=120 --seed=1 --effects="${EFFECTS[$name]}" --declare_effects=false \
+    --velocities=20 --pushes=120 --seed=1 --effects="${EFFECTS[$name]}" --declare_effects=false --testbed=ideal \
     --workers=1 > /dev/null 2>&1
   "$python" -m experiments.close_loop --data_dir="$work/data/$name" --workdir="$work/out/$name" > /dev/null 2>&1
   "$python" - "$work/out/$name/report.json" "$name" <<'PY'
