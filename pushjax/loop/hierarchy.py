@@ -45,6 +45,21 @@ def fit_groups(pool: Examples, effects: tuple[str, ...], variable: str, settings
     return [str(label) for label in groups], fits
 
 
+def pool_values(fits: Sequence[fit_lib.FitResult], effect: str
+                ) -> dict[str, tuple[np.ndarray, np.ndarray, metrics.RandomEffects]]:
+    """{value name: ([G] values, [G] standard errors, their random-effects pooling)} of ``effect`` over the groups'
+    fits; a value without a standard error on some group (not differentiable at its optimum) is left out."""
+    pooled = {}
+    for name in fits[0].physical[effect]:
+        estimates = [result.physical[effect][name] for result in fits]
+        if any(estimate["std"] is None or not estimate["std"] > 0 for estimate in estimates):
+            continue
+        value = np.array([estimate["value"] for estimate in estimates])
+        std = np.array([estimate["std"] for estimate in estimates])
+        pooled[name] = (value, std, metrics.random_effects(value, std))
+    return pooled
+
+
 @dataclasses.dataclass(frozen=True)
 class GroupValues:
     """One reported value of a selected effect over the groups of one variable.
@@ -84,13 +99,7 @@ def hierarchical(pool: Examples, model: fit_lib.FitResult, settings: fit_lib.Fit
     for variable in variables:
         groups, fits = fit_groups(pool, model.effects, variable, settings, model.params)
         for effect in model.effects if fits else ():
-            for name in fits[0].physical[effect]:
-                estimates = [result.physical[effect][name] for result in fits]
-                if any(estimate["std"] is None or not estimate["std"] > 0 for estimate in estimates):
-                    continue
-                value = np.array([estimate["value"] for estimate in estimates])
-                std = np.array([estimate["std"] for estimate in estimates])
-                pooled = metrics.random_effects(value, std)
+            for name, (value, std, pooled) in pool_values(fits, effect).items():
                 results.append(GroupValues(
                     variable=variable, effect=effect, value=name, shared={"value": pooled.mean, "std": pooled.mean_std},
                     spread=pooled.tau, p_value=pooled.p_value,

@@ -301,13 +301,7 @@ def check_mechanism(pool: Examples, effects: tuple[str, ...], added: str, settin
         if not fits:
             continue
         values[variable] = {label: result.physical[added] for label, result in zip(groups, fits)}
-        pooled = {}
-        for name in fits[0].physical[added]:
-            estimates = [result.physical[added][name] for result in fits]
-            if any(estimate["std"] is None or not estimate["std"] > 0 for estimate in estimates):
-                continue
-            pooled[name] = metrics.random_effects([estimate["value"] for estimate in estimates],
-                                                  [estimate["std"] for estimate in estimates])
+        pooled = {name: result for name, (_, _, result) in hierarchy.pool_values(fits, added).items()}
         centres = {name: result.fixed_mean for name, result in pooled.items()}
         for name, result in pooled.items():
             raw.append((result.p_value, variable, name,
