@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from pushjax.geometry import OBJECT_NAMES
+from pushjax.sim import scene
 from pushjax.sim.quasi_static import quasi_static_agreement
 
 
@@ -23,7 +24,7 @@ def main():
     parser.add_argument("--pushes", type=int, default=30, help="simulated pushes per object")
     parser.add_argument("--windows", type=int, default=10, help="windows drawn per push")
     parser.add_argument("--surface", default="abs")
-    parser.add_argument("--support", default="grid", choices=["grid", "hull"])
+    parser.add_argument("--support", default="grid", choices=scene.SUPPORT_MODES)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
 

@@ -38,6 +38,7 @@ from absl import app, flags
 
 import experiments
 from pushjax.geometry import OBJECT_NAMES
+from pushjax.sim import scene
 from pushjax.sim.dataset import START_POSES, OutDirConflictError, RecordingSettings, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
@@ -54,7 +55,7 @@ _EFFECTS = flags.DEFINE_string("effects", "", "Effects, e.g. 'com_offset=0.01,0.
 _DECLARE = flags.DEFINE_bool("declare_effects", True, "Write effects and seed as HDF5 attributes.")
 _REPEATS = flags.DEFINE_integer("repeats", 1, "Files per drawn push (_rep=NNNN when > 1).", lower_bound=1)
 _WORKERS = flags.DEFINE_integer("workers", None, "Worker processes (default: all cores).", lower_bound=1)
-_SUPPORT = flags.DEFINE_enum("support", "grid", ["grid", "hull"], "Support points of the object.")
+_SUPPORT = flags.DEFINE_enum("support", "grid", list(scene.SUPPORT_MODES), "Support points of the object.")
 _START_POSES = flags.DEFINE_enum(
     "start_poses", "fixed", list(START_POSES),
     "Where pushes start: fixed (the MIT protocol: every push from the table origin, yaw 0) or scattered (each from "

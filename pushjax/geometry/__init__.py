@@ -11,4 +11,5 @@ from pushjax.geometry.objects import (
     get_object,
     limit_surface_ratio,
     support_cells,
+    support_feet,
 )

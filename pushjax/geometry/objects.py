@@ -24,6 +24,7 @@ import importlib.resources
 from typing import Callable
 
 import numpy as np
+import scipy.optimize
 import shapely
 import trimesh
 
@@ -240,6 +241,39 @@ def support_cells(obj: PushObject, resolution: int = SUPPORT_RESOLUTION,
     # Centred on their own area centroid, which the sampling puts up to a few tenths of a cell off the plate's: a
     # uniform pressure then has its centre exactly at the centre of mass, as in Lynch's model.
     return centroids - weights @ centroids, weights, PATCH_RADIUS_OVER_CELL * cell
+
+
+FEET_SIMPLIFY = 0.05
+"""Tolerance of the convex hull's simplification in :func:`support_feet`, as a share of the footprint's longer side:
+a polygon keeps its corners, a curved outline becomes a ring of about a dozen."""
+_LOAD_BALANCE = 1e4
+"""Weight of the load-centre rows in :func:`support_feet`'s non-negative least squares (balance to about 1e-8 m)."""
+
+
+def support_feet(obj: PushObject) -> tuple[np.ndarray, np.ndarray]:
+    """The corners of the footprint's convex hull as point supports, loaded so the object balances on them.
+
+    The support of a plate whose base is not flat concentrates on the outermost points it can rest on: the corners
+    of its footprint's convex hull, the extreme distributions that bound every pressure within the footprint
+    (Peshkin and Sanderson 1988). The loads are those closest to equal shares that put their centre under the
+    centre of mass (static balance), found by non-negative least squares.
+
+    Args:
+      obj: the object.
+
+    Returns:
+      (points [F, 2] the hull's corners relative to the footprint's area centroid (the uniform plate's centre of
+      mass, as :func:`support_cells`), object axes, m; loads [F] >= 0 summing to 1 whose centre is that centroid).
+    """
+    outline = np.asarray(obj.outline, np.float64)
+    extent = float((outline.max(axis=0) - outline.min(axis=0)).max())
+    hull = shapely.Polygon(outline).convex_hull.simplify(FEET_SIMPLIFY * extent)
+    points = np.asarray(hull.exterior.coords)[:-1] - obj.centroid
+    equal = np.full(len(points), 1.0 / len(points))
+    balance = np.vstack([np.ones(len(points)), points.T / extent])
+    loads, _ = scipy.optimize.nnls(np.vstack([np.eye(len(points)), _LOAD_BALANCE * balance]),
+                                   np.concatenate([equal, _LOAD_BALANCE * np.array([1.0, 0.0, 0.0])]))
+    return points, loads / loads.sum()
 
 
 def _polygon_object(name: str, vertices) -> PushObject:

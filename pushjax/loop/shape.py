@@ -149,12 +149,15 @@ def rim_from_force(examples: Examples, measured: LimitSurfaceShape) -> dict[str,
     return {"value": float(-slope / (2 * curvature)), "std": float(1.0 / np.sqrt(curvature))}
 
 
-def _exact_wrench(twist: np.ndarray, inputs, rim: float) -> np.ndarray:
-    """[N, 3] the exact limit surface's wrench at ``twist`` for a pressure of rim loading ``rim`` (0: uniform)."""
+def _exact_wrench(twist: np.ndarray, inputs, rim: float, feet: float = 0.0) -> np.ndarray:
+    """[N, 3] the exact limit surface's wrench at ``twist`` for the pressure of ``limit_surface`` with rim loading
+    ``rim`` and a share ``feet`` on the hull's corners (both 0: uniform)."""
     weights = np.asarray(inputs.support_weights)
-    if rim != 0:
-        weights = np.asarray(effects_lib.support_pressure({"rim": rim}, jnp.asarray(inputs.support_points),
-                                                          jnp.asarray(weights)))
+    if rim != 0 or feet != 0:
+        corners = None if inputs.support_feet is None else jnp.asarray(inputs.support_feet)
+        weights = np.asarray(effects_lib.support_pressure({"rim": rim, "feet": feet},
+                                                          jnp.asarray(inputs.support_points), jnp.asarray(weights),
+                                                          corners))
     return np.asarray(limit_surface_lib.dissipation(twist, inputs.support_points, weights, inputs.patch_radius)[1],
                       np.float64)
 
@@ -178,8 +181,9 @@ def shape_models(examples: Examples, fitted: dict[str, dict] | None) -> dict[str
             [twist[:, :2], twist[:, 2] * (scale * l) ** 2])
     models["exact surface, uniform pressure"] = _exact_wrench(twist, inputs, 0.0)
     if "limit_surface" in fitted:
-        rim = float(fitted["limit_surface"]["rim"])
-        models[f"exact surface, fitted pressure (rim {rim:.3g})"] = _exact_wrench(twist, inputs, rim)
+        rim, feet = (float(fitted["limit_surface"][name]) for name in ("rim", "feet"))
+        models[f"exact surface, fitted pressure (rim {rim:.3g}, feet {feet:.3g})"] = _exact_wrench(twist, inputs, rim,
+                                                                                                  feet)
     return models
 
 

@@ -8,8 +8,8 @@ at ``t0 + horizon``, within the recording. Its model inputs are the contact anno
 displacement over the window against the object pose at ``t0`` (:func:`pushjax.geometry.annotate`;
 where the pusher stops short of the object, the contact it would make within :data:`LOOKAHEAD` further,
 with ``s = 0`` and no action), the pusher's speed and stop, the nominal limit-surface ratio of the
-object (uniform pressure), its footprint as support cells (:func:`pushjax.geometry.support_cells`, for the exact
-limit surface) and a nominal pusher friction; its
+object (uniform pressure), its footprint as support cells and its hull's corners as feet
+(:func:`pushjax.geometry.support_cells`, :func:`pushjax.geometry.support_feet`, for the exact limit surface) and a nominal pusher friction; its
 target is the displacement of the object's nominal centre of mass (the uniform plate's centroid in the
 tracked frame) and the change of yaw over the window.
 """
@@ -25,7 +25,15 @@ import jax
 import numpy as np
 
 from pushjax import planar
-from pushjax.geometry import OBJECT_NAMES, PUSHER_RADIUS, annotate, get_object, limit_surface_ratio, support_cells
+from pushjax.geometry import (
+    OBJECT_NAMES,
+    PUSHER_RADIUS,
+    annotate,
+    get_object,
+    limit_surface_ratio,
+    support_cells,
+    support_feet,
+)
 from pushjax.loop.force import sliding_friction, window_wrenches
 from pushjax.mit.files import Push
 from pushjax.physics.effects import PushInputs
@@ -241,12 +249,13 @@ def build_examples(
         raise ValueError(f"pushes: none gave a prediction window of {horizon} s ({reasons})")
 
     parts = [_annotate_object(name, object_rows, pusher_friction) for name, object_rows in sorted(rows.items())]
-    # Objects' supports have different numbers of cells: padded with zero-weight cells to the largest.
+    # Objects' supports have different numbers of points: padded with zero-weight points to the largest.
     cells = max(part["support_points"].shape[1] for part in parts)
     for part in parts:
         padding = cells - part["support_points"].shape[1]
         part["support_points"] = np.pad(part["support_points"], ((0, 0), (0, padding), (0, 0)))
         part["support_weights"] = np.pad(part["support_weights"], ((0, 0), (0, padding)))
+        part["support_feet"] = np.pad(part["support_feet"], ((0, 0), (0, padding)))
     merged = {key: np.concatenate([part[key] for part in parts]) for key in parts[0] if key != "variables"}
     variables = {name: np.concatenate([part["variables"][name] for part in parts]) for name in VARIABLES}
     inputs = PushInputs(**{field.name: merged[field.name] for field in dataclasses.fields(PushInputs)})
@@ -282,7 +291,11 @@ def _annotate_object(name: str, rows: list[dict], pusher_friction: float) -> dic
     gap = np.where(annotated, np.sum((contact_world - tip0) * normal, axis=1) - PUSHER_RADIUS, 0.0)
     com0, com1 = planar.centre_of_mass(obj.centroid, pose0), planar.centre_of_mass(obj.centroid, pose1)
     count = len(pose0)
-    support_points, support_weights, patch_radius = support_cells(obj)
+    cells, cell_areas, patch_radius = support_cells(obj)
+    feet, feet_loads = support_feet(obj)
+    support_points = np.concatenate([cells, feet])
+    support_weights = np.concatenate([cell_areas, np.zeros(len(feet))])
+    support_feet_loads = np.concatenate([np.zeros(len(cells)), feet_loads])
     yaw = pose0[:, 2]
     variables = {
         "push velocity": np.array([p.velocity for p in params]),
@@ -305,6 +318,7 @@ def _annotate_object(name: str, rows: list[dict], pusher_friction: float) -> dic
         support_points=np.broadcast_to(support_points, (count, *support_points.shape)),
         support_weights=np.broadcast_to(support_weights, (count, len(support_weights))),
         patch_radius=np.full(count, patch_radius),
+        support_feet=np.broadcast_to(support_feet_loads, (count, len(support_feet_loads))),
         target=np.column_stack([com1 - com0, pose1[:, 2] - pose0[:, 2]]),
         sequence=data["sequence"], push=data["push"], window=data["window"], tracking_noise=data["tracking_noise"],
         push_friction=data["push_friction"], wrench=data["wrench"],

@@ -83,17 +83,20 @@ composed. The effects (the keys of :data:`EFFECTS`, applied in this order whatev
     ``E|r|^2 = (9/8) l^2``). One mechanism, so the shift and ``l`` move together (unlike ``cof_offset`` plus
     ``friction_ratio``).
 
-``limit_surface``  {"rim": [] -}
+``limit_surface``  {"rim": [] -, "feet": [] share in [0, 1]}
     The exact limit surface of the support instead of Lynch's ellipsoid (which matches the exact one only at
     pure translation and pure rotation): the quasi-static, maximal-dissipation twist of the support described by
-    ``PushInputs.support_points`` and ``support_weights`` (area weights of cells of the footprint,
-    :func:`pushjax.geometry.support_cells`), solved by :func:`pushjax.physics.limit_surface.predict`. The support
-    pressure is ``area_k exp(rim (|r_k|^2 / E|r|^2 - 1))``: ``rim > 0`` loads the rim (a plate resting on its edge
-    spins harder), ``rim < 0`` the centre. A moved centre of pressure is ``cof_offset``, which moves this support with
-    it. It replaces the ellipsoid, so its zero parameter is the exact surface of a uniform pressure, not Lynch's
-    model; it cannot be composed with the effects that change the ellipsoid (:data:`EFFECTS`' ``excludes``:
-    ``friction_ratio`` and ``pressure_gradient``, whose ``l`` it does not use, and ``anisotropic_friction``, which the
-    exact surface does not model).
+    ``PushInputs.support_points``, ``support_weights`` (area weights of cells of the footprint,
+    :func:`pushjax.geometry.support_cells`) and ``support_feet`` (the corners of the footprint's convex hull,
+    :func:`pushjax.geometry.support_feet`), solved by :func:`pushjax.physics.limit_surface.predict`. Over the
+    footprint the pressure is ``area_k exp(rim (|r_k|^2 / E|r|^2 - 1))``: ``rim > 0`` loads the rim (a plate resting
+    on its edge spins harder), ``rim < 0`` the centre. A share ``feet`` of the load rests on the hull's corners
+    instead (a base that is not flat, stiff feet: the outermost support an object can have, balanced under its
+    centre of mass). A moved centre of pressure is ``cof_offset``, which moves this support with it. It replaces the
+    ellipsoid, so its zero parameter is the exact surface of a uniform pressure, not Lynch's model; it cannot be
+    composed with the effects that change the ellipsoid (:data:`EFFECTS`' ``excludes``: ``friction_ratio`` and
+    ``pressure_gradient``, whose ``l`` it does not use, and ``anisotropic_friction``, which the exact surface does not
+    model).
 
 All branches are double-``where`` selections, so gradients are finite everywhere, including the
 no-effect parameters, ``normal = 0``, ``action = 0`` and ``s = 0``.
@@ -153,8 +156,12 @@ class PushInputs:
       object_position: [..., 2] position of the nominal centre of mass on the table at the window's start,
         world axes, m.
       support_points: [..., K, 2] points of the object's support relative to the nominal centre of mass, object
-        axes, m (:func:`pushjax.geometry.support_cells`); None when unknown (``limit_surface`` needs them).
-      support_weights: [..., K] their area weights (>= 0, zero for padding); None with ``support_points``.
+        axes, m: the footprint's cells (:func:`pushjax.geometry.support_cells`) and the corners of its convex hull
+        (:func:`pushjax.geometry.support_feet`); None when unknown (``limit_surface`` needs them).
+      support_weights: [..., K] their area weights (>= 0; zero for the hull's corners and padding); None with
+        ``support_points``.
+      support_feet: [..., K] the loads of the object resting on its hull's corners (>= 0, summing to 1; zero for the
+        cells and padding); None: no corners among the points.
       patch_radius: [...] the radius of a support's patch, m (the solve's regularisation length).
     """
 
@@ -173,11 +180,12 @@ class PushInputs:
     support_points: jax.Array | None = None
     support_weights: jax.Array | None = None
     patch_radius: jax.Array | None = None
+    support_feet: jax.Array | None = None
 
     @classmethod
     def create(cls, contact, normal, action, l, mu, s=1.0, *, pusher_motion=None, gap=0.0,
                object_yaw=0.0, push_speed=0.0, time_after_stop=0.0, object_position=(0.0, 0.0),
-               support_points=None, support_weights=None, patch_radius=None) -> PushInputs:
+               support_points=None, support_weights=None, patch_radius=None, support_feet=None) -> PushInputs:
         """Inputs from ``lynch.predict``'s arguments; the others default to a pusher in contact
         (``pusher_motion = action``, ``gap = 0``), object yaw 0 at the table's origin, a pusher that does
         not stop and an unknown support."""
@@ -193,7 +201,7 @@ class PushInputs:
             object_yaw=jnp.asarray(object_yaw), push_speed=jnp.asarray(push_speed),
             time_after_stop=jnp.asarray(time_after_stop), object_position=jnp.asarray(object_position),
             support_points=optional(support_points), support_weights=optional(support_weights),
-            patch_radius=optional(patch_radius),
+            patch_radius=optional(patch_radius), support_feet=optional(support_feet),
         )
 
 
@@ -447,15 +455,27 @@ def _inertia_physical(params):
             "decay_length_mm_at_100_mm_s": 1e3 * 0.5 * 0.1 ** 2 * inverse}
 
 
-def support_pressure(params: Params, points: jax.Array, area: jax.Array) -> jax.Array:
-    """[..., K] normalised support pressure of ``limit_surface`` at [..., K, 2] ``points`` (object axes, m) with
-    area weights [..., K] (see the module docstring)."""
+def support_pressure(params: Params, points: jax.Array, area: jax.Array, feet: jax.Array | None = None) -> jax.Array:
+    """[..., K] normalised support pressure of ``limit_surface`` (see the module docstring).
+
+    Args:
+      params: ``limit_surface``'s parameters (``rim`` [...], ``feet`` [...] in [0, 1]).
+      points: [..., K, 2] support points, object axes, m.
+      area: [..., K] their area weights (zero for the hull's corners).
+      feet: [..., K] the loads on the hull's corners (:attr:`PushInputs.support_feet`); None: no corners, ``feet``
+        must then be 0.
+    """
     area = area / jnp.sum(area, axis=-1, keepdims=True)
     square = jnp.sum(points ** 2, axis=-1)
     mean_square = jnp.sum(area * square, axis=-1, keepdims=True)
     log_pressure = jnp.asarray(params["rim"])[..., None] * (square / mean_square - 1.0)
+    log_pressure = jnp.where(area > 0, log_pressure, -jnp.inf)
     weights = area * jnp.exp(log_pressure - jnp.max(log_pressure, axis=-1, keepdims=True))
-    return weights / jnp.sum(weights, axis=-1, keepdims=True)
+    footprint = weights / jnp.sum(weights, axis=-1, keepdims=True)
+    if feet is None:
+        return footprint
+    share = jnp.asarray(params["feet"])[..., None]
+    return (1.0 - share) * footprint + share * feet
 
 
 def _limit_surface_solve(params, state, inputs):
@@ -463,7 +483,8 @@ def _limit_surface_solve(params, state, inputs):
         raise ValueError("limit_surface: needs PushInputs.support_points, support_weights and patch_radius "
                          "(pushjax.geometry.support_cells)")
     points = jnp.asarray(inputs.support_points)
-    pressure = support_pressure(params, points, jnp.asarray(inputs.support_weights))
+    feet = None if inputs.support_feet is None else jnp.asarray(inputs.support_feet)
+    pressure = support_pressure(params, points, jnp.asarray(inputs.support_weights), feet)
     # World axes. The support is centred where the other effects put the centre of friction (cof_offset moves the
     # pressure with it, frame_offset the whole plate), and the contact is relative to that centre.
     world = _rotate(points, jnp.asarray(inputs.object_yaw)[..., None])
@@ -474,7 +495,11 @@ def _limit_surface_solve(params, state, inputs):
 
 
 def _limit_surface_physical(params):
-    return {"rim": params["rim"]}
+    return {"rim": params["rim"], "feet": params["feet"]}
+
+
+def _limit_surface_project(params):
+    return {**params, "feet": jnp.clip(params["feet"], 0.0, 1.0)}
 
 
 LIMIT_SURFACE_ITERATIONS = (5, 6)
@@ -523,8 +548,8 @@ EFFECTS: dict[str, Effect] = {
                project=_friction_speed_project, physical=_friction_speed_physical),
         Effect(name="pressure_gradient", init=_zeros(offset=(2,)), typical={"offset": 0.01},
                modify=_pressure_gradient_modify, physical=_pressure_gradient_physical, per_object=True),
-        Effect(name="limit_surface", init=_zeros(rim=()), typical={"rim": 1.0}, physical=_limit_surface_physical,
-               solve=_limit_surface_solve, excludes=("friction_ratio", "pressure_gradient", "anisotropic_friction"),
+        Effect(name="limit_surface", init=_zeros(rim=(), feet=()), typical={"rim": 1.0, "feet": 0.3},
+               physical=_limit_surface_physical, project=_limit_surface_project, solve=_limit_surface_solve, excludes=("friction_ratio", "pressure_gradient", "anisotropic_friction"),
                per_object=True),
     )
 }

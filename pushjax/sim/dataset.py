@@ -82,7 +82,7 @@ class RecordingSettings:
       effects: effects of every push.
       declare_effects: write the effects, seed etc. as HDF5 attributes; False writes exactly the three datasets
         of a real MIT file.
-      support: support mode (``grid`` or ``hull``, :data:`pushjax.sim.scene.SUPPORT_MODES`).
+      support: support mode (:data:`pushjax.sim.scene.SUPPORT_MODES`).
       testbed: the testbed profile (:mod:`pushjax.sim.testbed`); :data:`~pushjax.sim.testbed.REALISTIC` as in every
         command and dataset config, :data:`~pushjax.sim.testbed.IDEAL` gives the files recorded before testbeds
         existed.

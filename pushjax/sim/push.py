@@ -111,7 +111,7 @@ class Simulator:
       obj: the object or its name.
       surface: surface name.
       effects: the effects; the physical ones shape the model, the tracking ones the recorded poses.
-      support: ``"grid"`` or ``"hull"`` (see :mod:`pushjax.sim.scene`).
+      support: one of :data:`pushjax.sim.scene.SUPPORT_MODES`.
     """
 
     def __init__(self, obj: PushObject | str, surface: str, effects: Effects = Effects(), support: str = "grid"):

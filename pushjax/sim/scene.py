@@ -28,7 +28,9 @@ Geometry and contacts:
   Voronoi tessellation of the footprint (Lloyd's algorithm), each standing for the area of its cell, so that
   the limit-surface ratio of the discrete supports is within ~2 % of the uniform-pressure value (the distributed
   pressure of a flat plate); ``support="hull"`` places one support 1 mm inside each corner of the outline's
-  convex hull (simplified to 0.5 mm for curved outlines), as for a plate resting on its rim. Each support is a
+  convex hull (simplified to 0.5 mm for curved outlines), as for a plate on stiff feet; ``support="ring"`` places 16
+  supports 1 mm inside the outline at equal spacing along it, as for a plate with a dished base resting on its
+  edge. Each support is a
   tiny capsule with its axis along the object's x axis, raised by 10° so that only its lower end touches the
   table: MuJoCo's plane–capsule contact takes the capsule axis as the first tangent of the contact frame, which
   ties the friction ellipse of anisotropic contacts to the OBJECT frame (checked in tests/sim).
@@ -77,7 +79,7 @@ from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION, get_surface
 
 TIMESTEP = 2e-3
 """Default simulation step in s (the step of slow pushes; ``pushjax.sim.push`` sets it per push)."""
-SUPPORT_MODES = ("grid", "hull")
+SUPPORT_MODES = ("grid", "hull", "ring")
 GRID_SUPPORTS = 24
 """Number of support points in ``support="grid"`` mode."""
 SUPPORT_RADIUS = 1e-4
@@ -87,7 +89,9 @@ SUPPORT_HALF_LENGTH = 1e-3
 SUPPORT_RAISE_DEG = 10.0
 """Angle between a support capsule's axis and the plate's bottom face, so only its lower end touches."""
 HULL_INSET = 1e-3
-"""Distance in m by which ``support="hull"`` points are moved from the hull corners towards the centroid."""
+"""Distance in m by which ``support="hull"`` and ``"ring"`` points are moved from the outline towards the centroid."""
+RING_SUPPORTS = 16
+"""Number of support points in ``support="ring"`` mode."""
 PUSHER_HALF_HEIGHT = 0.05
 """Half height of the pusher cylinder in m (a 10 cm probe)."""
 PUSHER_MASS = 20.0
@@ -137,17 +141,18 @@ def support_points(obj: PushObject | str, support: str = "grid") -> tuple[np.nda
 
     Args:
       obj: the object or its name.
-      support: ``"grid"`` (distributed over the footprint) or ``"hull"`` (convex-hull corners).
+      support: ``"grid"`` (distributed over the footprint), ``"hull"`` (convex-hull corners) or ``"ring"`` (along
+        the outline).
 
     Returns:
       ([K, 2] points in m in the tracked frame, [K] weights with mean 1: the cell areas relative to the
-      mean cell area for ``"grid"``, ones for ``"hull"``).
+      mean cell area for ``"grid"``, ones for ``"hull"`` and ``"ring"``).
     """
     if isinstance(obj, str):
         obj = get_object(obj)
     if support not in SUPPORT_MODES:
         raise ValueError(f"support: expected one of {', '.join(SUPPORT_MODES)}, got {support!r}")
-    points, weights = (_grid_supports if support == "grid" else _hull_supports)(obj)
+    points, weights = {"grid": _grid_supports, "hull": _hull_supports, "ring": _ring_supports}[support](obj)
     return points.copy(), weights.copy()
 
 
@@ -176,9 +181,21 @@ def _grid_supports(obj: PushObject) -> tuple[np.ndarray, np.ndarray]:
 def _hull_supports(obj: PushObject) -> tuple[np.ndarray, np.ndarray]:
     hull = shapely.Polygon(obj.outline).convex_hull.simplify(5e-4)
     corners = np.asarray(hull.exterior.coords)[:-1]
-    towards_centroid = obj.centroid - corners
-    corners = corners + HULL_INSET * towards_centroid / np.linalg.norm(towards_centroid, axis=1, keepdims=True)
-    return corners, np.ones(len(corners))
+    return _inset(corners, obj.centroid), np.ones(len(corners))
+
+
+@functools.cache
+def _ring_supports(obj: PushObject) -> tuple[np.ndarray, np.ndarray]:
+    outline = shapely.Polygon(obj.outline).exterior
+    points = np.array([outline.interpolate(k / RING_SUPPORTS, normalized=True).coords[0]
+                       for k in range(RING_SUPPORTS)])
+    return _inset(points, obj.centroid), np.ones(RING_SUPPORTS)
+
+
+def _inset(points: np.ndarray, centroid: np.ndarray) -> np.ndarray:
+    """[K, 2] ``points`` moved by :data:`HULL_INSET` towards ``centroid``."""
+    towards_centroid = centroid - points
+    return points + HULL_INSET * towards_centroid / np.linalg.norm(towards_centroid, axis=1, keepdims=True)
 
 
 def support_friction(obj: PushObject | str, surface: str, effects: Effects = Effects(),
@@ -278,7 +295,7 @@ def scene_spec(obj: PushObject | str, surface: str, effects: Effects = Effects()
       obj: the object or its name (see ``pushjax.geometry.OBJECT_NAMES``).
       surface: support surface name (``abs``, ``delrin``, ``plywood`` or ``pu``).
       effects: physical effects; the tracking effects do not change the scene.
-      support: ``"grid"`` or ``"hull"``, see the module docstring.
+      support: one of :data:`SUPPORT_MODES`, see the module docstring.
 
     Returns:
       The specification; ``.compile()`` gives the model, ``.to_xml()`` its MJCF.

@@ -7,7 +7,7 @@ import pytest
 import shapely
 import trimesh
 
-from pushjax.geometry import OBJECT_NAMES, get_object, limit_surface_ratio, support_cells
+from pushjax.geometry import OBJECT_NAMES, get_object, limit_surface_ratio, support_cells, support_feet
 
 # The dataset's .obj files are Y-up: the plate's plane is the mesh's (x, z), which maps to the
 # object's (x, y) unchanged (the right-angle corner of the triangles is at mesh (+45, +45) mm).
@@ -161,3 +161,26 @@ def test_support_cells_cover_the_footprint_with_its_area(name):
     intercept = weights @ np.sqrt(np.sum(points ** 2, axis=1) + radius ** 2)
     assert abs(intercept / limit_surface_ratio(obj) - 1) < 0.025
     assert 0 < radius < 0.015
+
+
+@pytest.mark.parametrize("name", OBJECT_NAMES)
+def test_support_feet_are_hull_corners_that_balance_the_object(name):
+    obj = get_object(name)
+    points, loads = support_feet(obj)
+    assert 3 <= len(points) <= 16 and points.shape == (len(points), 2)
+    assert np.all(loads >= 0) and loads.sum() == pytest.approx(1.0)
+    np.testing.assert_allclose(loads @ points, 0.0, atol=1e-7)  # the load's centre under the centre of mass
+    hull = shapely.Polygon(obj.outline).convex_hull
+    on_hull = [hull.exterior.distance(shapely.Point(*(point + obj.centroid))) for point in points]
+    assert max(on_hull) < 1e-9
+    # The outermost support: every corner is farther from the centre of mass than the footprint's mean radius.
+    cells, areas, _ = support_cells(obj)
+    assert np.min(np.linalg.norm(points, axis=1)) > areas @ np.linalg.norm(cells, axis=1)
+
+
+def test_support_feet_of_a_rectangle_are_its_corners_with_equal_loads():
+    obj = get_object("rect1")
+    points, loads = support_feet(obj)
+    half = (obj.outline.max(axis=0) - obj.outline.min(axis=0)) / 2
+    np.testing.assert_allclose(np.sort(np.abs(points), axis=0), np.tile(half, (4, 1)), atol=1e-12)
+    np.testing.assert_allclose(loads, 0.25)

@@ -46,10 +46,10 @@ def test_the_force_sensor_sees_the_exact_surface_not_the_ellipsoid(record):
     rim = shape.rim_from_force(examples, result)
     assert abs(rim["value"]) < 0.15 and 0 < rim["std"] < 0.05, rim
     # A rim-loaded pressure moves the ratio near translation up, towards l.
-    rim_loaded = shape.shape_models(examples, {"limit_surface": {"rim": np.array(2.0)}})
+    rim_loaded = shape.shape_models(examples, {"limit_surface": {"rim": np.array(2.0), "feet": np.array(0.0)}})
     rim_result = shape.limit_surface_shape(shape.measured_twists(examples), examples.wrench, examples.inputs.l,
                                            examples.sequence, rim_loaded)
-    assert rim_result.models["exact surface, fitted pressure (rim 2)"][0] > exact[0] + 0.05
+    assert rim_result.models["exact surface, fitted pressure (rim 2, feet 0)"][0] > exact[0] + 0.05
 
 
 def test_window_wrenches_are_missing_where_the_sensor_reads_nothing(record):

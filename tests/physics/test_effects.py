@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from pushjax.physics import effects, lynch
+from pushjax.physics import limit_surface as exact_limit_surface
 
 
 def _unit(angle):
@@ -367,16 +368,46 @@ def test_limit_surface_is_the_exact_surface_of_the_support_and_moves_with_its_pr
     np.testing.assert_allclose(model(zero, centred)[:, 2], 0.0, atol=1e-5)
     assert np.mean(np.abs(uniform - ellipsoid)) > 1e-5
     # Loading the rim makes turning harder; loading the centre easier.
-    rim = {"limit_surface": {"rim": jnp.asarray(1.0)}}
-    centre = {"limit_surface": {"rim": jnp.asarray(-1.0)}}
+    rim = {"limit_surface": {"rim": jnp.asarray(1.0), "feet": jnp.asarray(0.0)}}
+    centre = {"limit_surface": {"rim": jnp.asarray(-1.0), "feet": jnp.asarray(0.0)}}
     turned = np.abs(uniform[:, 2]) > 1e-3
     assert np.all(np.abs(np.asarray(model(rim, inputs))[turned, 2]) < np.abs(uniform[turned, 2]))
     assert np.all(np.abs(np.asarray(model(centre, inputs))[turned, 2]) > np.abs(uniform[turned, 2]))
     # cof_offset moves the support with the centre of pressure: towards +x, a push along +y through the centre of
     # mass passes on its left and turns the plate clockwise.
     shifted = effects.compose(["cof_offset", "limit_surface"])
-    params = {"cof_offset": {"offset": jnp.array([0.005, 0.0])}, "limit_surface": {"rim": jnp.asarray(0.0)}}
+    params = {"cof_offset": {"offset": jnp.array([0.005, 0.0])}, "limit_surface": {"rim": jnp.asarray(0.0), "feet": jnp.asarray(0.0)}}
     assert np.all(np.asarray(shifted(params, centred))[:, 2] < -1e-4)
+
+
+def test_limit_surface_feet_rest_a_share_of_the_load_on_the_hull_corners():
+    cells = _pushes_on_a_square(count=60, seed=2)
+    corners = np.array([[0.04, 0.04], [-0.04, 0.04], [-0.04, -0.04], [0.04, -0.04]])
+    count, k = cells.support_weights.shape
+    inputs = cells.replace(
+        support_points=jnp.concatenate([cells.support_points, jnp.broadcast_to(corners, (count, 4, 2))], axis=1),
+        support_weights=jnp.concatenate([cells.support_weights, jnp.zeros((count, 4))], axis=1),
+        support_feet=jnp.concatenate([jnp.zeros((count, k)), jnp.full((count, 4), 0.25)], axis=1))
+    model = jax.jit(effects.compose(["limit_surface"]))
+    zero = effects.init_params(["limit_surface"])
+    # No share on the feet: the corners carry nothing, the footprint's exact surface as without them.
+    np.testing.assert_allclose(model(zero, inputs), model(zero, cells), rtol=1e-6, atol=1e-9)
+    # All of it: the exact surface of the four corners alone.
+    on_feet = {"limit_surface": {"rim": jnp.asarray(0.0), "feet": jnp.asarray(1.0)}}
+    alone = exact_limit_surface.predict(cells.contact, cells.normal, cells.action, cells.mu,
+                                        jnp.broadcast_to(corners, (count, 4, 2)), jnp.full((count, 4), 0.25),
+                                        cells.patch_radius)
+    np.testing.assert_allclose(model(on_feet, inputs), alone, rtol=1e-5, atol=1e-8)
+    # Half of it turns the plate less than the footprint and more than the feet alone; the share is differentiable
+    # and kept within [0, 1].
+    half = {"limit_surface": {"rim": jnp.asarray(0.0), "feet": jnp.asarray(0.5)}}
+    turned = np.abs(np.asarray(model(zero, inputs))[:, 2]) > 1e-3
+    rotation = [np.abs(np.asarray(model(params, inputs))[turned, 2]) for params in (zero, half, on_feet)]
+    assert np.all(rotation[0] > rotation[1]) and np.all(rotation[1] > rotation[2])
+    gradient = jax.grad(lambda p: jnp.sum(model(p, inputs)[:, 2] ** 2))(half)
+    assert np.isfinite(gradient["limit_surface"]["feet"]) and gradient["limit_surface"]["feet"] < 0
+    projected = effects.EFFECTS["limit_surface"].project({"rim": jnp.asarray(2.0), "feet": jnp.asarray(1.7)})
+    assert float(projected["feet"]) == 1.0 and float(projected["rim"]) == 2.0
 
 
 def test_limit_surface_is_differentiable_and_refuses_what_it_cannot_compose():
@@ -386,7 +417,7 @@ def test_limit_surface_is_differentiable_and_refuses_what_it_cannot_compose():
     params = {name: values for name, values in _random_params(3).items() if name in names}
     # (A random frame offset moves these pushes' contacts off the square's side: no motion to differentiate.)
     params["frame_offset"] = {"offset": jnp.zeros(2)}
-    params["limit_surface"] = {"rim": jnp.asarray(0.3)}
+    params["limit_surface"] = {"rim": jnp.asarray(0.3), "feet": jnp.asarray(0.0)}
     gradient = jax.grad(lambda p: jnp.sum(model(p, inputs) ** 2))(params)
     assert all(np.all(np.isfinite(leaf)) for leaf in jax.tree.leaves(gradient))
     assert np.asarray(gradient["limit_surface"]["rim"]) != 0 and np.all(np.asarray(gradient["cof_offset"]["offset"]) != 0)

@@ -164,6 +164,14 @@ def test_rim_pressure_reduces_rotation():
     assert rotations[0] > rotations[1] * 1.1 > rotations[2] * 1.2
 
 
+def test_supports_farther_out_turn_the_plate_less():
+    # The same off-centre push: a plate on its grid (distributed pressure) turns most, on a ring along its outline
+    # less, on its four corners least (the limit surface's torque grows with the supports' distance).
+    p = params(point=0.8)
+    rotations = [abs(motion(simulate_push(p, support=support))[1]) for support in ("grid", "ring", "hull")]
+    assert rotations[0] > rotations[1] * 1.1 > rotations[2] * 1.1
+
+
 def test_anisotropic_friction_turns_the_sliding_direction():
     """A slanted central push: the plate slides preferably along its low-friction axis."""
     p = params(angle=0.6)

@@ -88,8 +88,22 @@ def test_hull_supports_sit_near_the_hull_corners():
     assert len(points) == 4 and np.all(weights == 1)
     corner_distance = np.linalg.norm(points[:, None] - obj.outline[None], axis=-1).min(axis=1)
     np.testing.assert_allclose(corner_distance, scene.HULL_INSET)
-    with pytest.raises(ValueError, match="support"):
-        scene.support_points(obj, "ring")
+    with pytest.raises(ValueError, match="support: expected one of grid, hull, ring"):
+        scene.support_points(obj, "feet")
+
+
+@pytest.mark.parametrize("name", ["rect2", "butter"])
+def test_ring_supports_run_along_the_outline_just_inside_it(name):
+    obj = get_object(name)
+    points, weights = scene.support_points(obj, "ring")
+    assert len(points) == scene.RING_SUPPORTS and np.all(weights == 1)
+    outline = shapely.Polygon(obj.outline)
+    assert all(outline.contains(shapely.Point(*point)) for point in points)
+    distance = [outline.exterior.distance(shapely.Point(*point)) for point in points]
+    assert max(distance) <= scene.HULL_INSET + 1e-12 and min(distance) > 0.3 * scene.HULL_INSET
+    # Equally spaced along the outline: consecutive points a sixteenth of the perimeter apart, to within the inset.
+    gaps = np.linalg.norm(np.roll(points, -1, axis=0) - points, axis=1)
+    assert np.max(gaps) <= outline.exterior.length / scene.RING_SUPPORTS + 2 * scene.HULL_INSET
 
 
 def test_support_friction_realises_pressure_and_anisotropy():
