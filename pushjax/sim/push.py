@@ -37,7 +37,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import mujoco
 import numpy as np
@@ -157,7 +157,8 @@ class Simulator:
         return settled
 
     def run(self, params: PushParams, initial_pose: Sequence[float] = (0.0, 0.0, 0.0),
-            rng: np.random.Generator | None = None, conditions: PushConditions | None = None) -> Recording:
+            rng: np.random.Generator | None = None, conditions: PushConditions | None = None,
+            on_step: Callable[[Simulator], None] | None = None) -> Recording:
         """Simulates and records one push.
 
         Args:
@@ -166,6 +167,8 @@ class Simulator:
           rng: random generator for the tracking noise; required when ``effects.tracking_noise`` is non-zero.
           conditions: the testbed's draw for this push (:func:`pushjax.sim.testbed.draw_conditions`; its
             ``plate_pressure`` must have one value per support point); None: the ideal testbed.
+          on_step: called with this simulator after every physics step (e.g. to read
+            :meth:`support_normal_forces`); the push is then stepped in Python, the same simulation but slower.
 
         Returns:
           The :class:`Recording`.
@@ -194,10 +197,10 @@ class Simulator:
             raise ValueError("rng: required to draw the tracking noise of these effects")
 
         line_shift = 0.0
-        true_pose, tip_pose, ft_wrench = self._simulate(params, pose, conditions, line_shift)
+        true_pose, tip_pose, ft_wrench = self._simulate(params, pose, conditions, line_shift, on_step)
         if implausible_speed(true_pose, params) is not None:
             line_shift = CORNER_SHIFT
-            true_pose, tip_pose, ft_wrench = self._simulate(params, pose, conditions, line_shift)
+            true_pose, tip_pose, ft_wrench = self._simulate(params, pose, conditions, line_shift, on_step)
             if (speed := implausible_speed(true_pose, params)) is not None:
                 raise ImplausibleMotionError(
                     f"params: {params}: the object moved at {speed * 1000:.0f} mm/s behind a pusher at "
@@ -210,7 +213,8 @@ class Simulator:
                          true_object_pose=true_pose, line_shift=line_shift)
 
     def _simulate(self, params: PushParams, pose: np.ndarray, conditions: PushConditions | None,
-                  line_shift: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                  line_shift: float, on_step: Callable[[Simulator], None] | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """([N, 4] true object pose, [N, 4] tip pose, [N, 4] wrench) of one push (see :meth:`run`), its pusher's
         line moved ``line_shift`` m along the pushed side towards the side's middle."""
         model, data = self.model, self.data
@@ -231,13 +235,13 @@ class Simulator:
             target_xy, speed[:, None] * direction, target_xy, np.full((nstep, 1), self._pusher_z)], axis=1)
 
         initial_state = self._place(pose, start, pusher_motion(params, np.zeros(1))[1][0] * direction)
-        if conditions is None:
+        if conditions is None and on_step is None:
             states, sensors = rollout.rollout(
                 model, data, initial_state[None], control[None], control_spec=self._control_spec,
                 initial_warmstart=np.zeros((1, model.nv)))
             qpos_steps, sensors = states[0][:, 1:1 + model.nq], sensors[0]
         else:
-            qpos_steps, sensors = self._stepped(control, conditions, steps_per_sample)
+            qpos_steps, sensors = self._stepped(control, conditions, steps_per_sample, on_step)
 
         # qpos_steps[k] follows step k; prepend the initial state so that index k is time k * timestep.
         qpos_path = np.concatenate([initial_state[None, 1:1 + model.nq], qpos_steps])
@@ -273,12 +277,13 @@ class Simulator:
         mujoco.mj_getState(model, data, initial_state, self._state_spec)
         return initial_state
 
-    def _stepped(self, control: np.ndarray, conditions: PushConditions | None,
-                 steps_per_update: int) -> tuple[np.ndarray, np.ndarray]:
+    def _stepped(self, control: np.ndarray, conditions: PushConditions | None, steps_per_update: int,
+                 on_step: Callable[[Simulator], None] | None = None) -> tuple[np.ndarray, np.ndarray]:
         """([nstep, nq] qpos after each step, [nstep, nsensordata] sensors at the state before each step) of the
         push whose state ``self.data`` holds, under the coefficients of ``conditions``: the pusher's for the whole
         push, the supports' set from the object's state every ``steps_per_update`` steps (see the module docstring;
-        the model's coefficients are restored afterwards); None: the model's own coefficients."""
+        the model's coefficients are restored afterwards); None: the model's own coefficients. ``on_step`` (if any)
+        is called after every step."""
         model, data = self.model, self.data
         nominal = model.pair_friction.copy()
         support_nominal = nominal[self._support_pairs, :2]
@@ -309,9 +314,37 @@ class Simulator:
                     mujoco.mj_step(model, data)
                     qpos_steps[k] = qpos
                     sensors[k] = sensordata
+                    if on_step is not None:
+                        on_step(self)
         finally:
             model.pair_friction[:] = nominal
         return qpos_steps, sensors
+
+    @property
+    def support_points(self) -> np.ndarray:
+        """[K, 2] the support points in the tracked frame, m (:func:`pushjax.sim.scene.support_points`)."""
+        return self._support_local.copy()
+
+    def support_normal_forces(self) -> np.ndarray:
+        """[K] normal force of each support point on the table in the current state, N (0 where it does not
+        touch)."""
+        model, data = self.model, self.data
+        support_of_geom = {int(model.geom(f"support{k}").id): k for k in range(len(self._support_local))}
+        forces, wrench = np.zeros(len(self._support_local)), np.zeros(6)
+        for c in range(data.ncon):
+            contact = data.contact[c]
+            k = support_of_geom.get(int(contact.geom1), support_of_geom.get(int(contact.geom2)))
+            if k is not None:
+                mujoco.mj_contactForce(model, data, c, wrench)
+                forces[k] += wrench[0]
+        return forces
+
+    def object_velocity(self) -> np.ndarray:
+        """[3] the tracked frame's velocity along its own axes (m/s) and its yaw rate (rad/s) in the current state."""
+        (_, _, yaw), _ = self._support_motion()
+        dof = self._object_dof
+        vx, vy, _, _, _, spin = self.data.qvel[dof:dof + 6].tolist()
+        return np.array([math.cos(yaw) * vx + math.sin(yaw) * vy, math.cos(yaw) * vy - math.sin(yaw) * vx, spin])
 
     def _support_motion(self) -> tuple[tuple[float, float, float], np.ndarray]:
         """(pose (x m, y m, yaw rad) of the tracked frame, [K] sliding speeds of the support points in m/s) in

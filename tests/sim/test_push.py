@@ -172,6 +172,32 @@ def test_supports_farther_out_turn_the_plate_less():
     assert rotations[0] > rotations[1] * 1.1 > rotations[2] * 1.1
 
 
+@pytest.mark.parametrize("surface", ["delrin", "pu"])
+def test_the_pushing_force_moves_the_load_to_the_leading_edge(surface):
+    # The pusher presses on the plate's side at half its thickness, the table's friction acts at its base: the
+    # moment tips the load towards the side the plate slides to, by mu * thickness / 2 (moment balance), which
+    # Lynch's planar model leaves out. Measured from the supports' normal forces while the plate slides.
+    sim = Simulator("rect1", surface)
+    centres, velocities = [], []
+
+    def record(simulator):
+        forces = simulator.support_normal_forces()
+        centres.append(forces @ simulator.support_points / forces.sum())
+        velocities.append(simulator.object_velocity())
+
+    recording = sim.run(params(surface=surface), on_step=record)
+    np.testing.assert_array_equal(recording.true_object_pose, simulate_push(params(surface=surface)).true_object_pose)
+    centres, velocities = np.array(centres), np.array(velocities)
+    sliding = velocities[:, 0] < -0.9 * params().velocity_si  # side 0 is pushed towards -x
+    assert sliding.sum() > 100
+    expected = SURFACES[surface].object_friction * get_object("rect1").thickness / 2
+    assert np.median(-centres[sliding, 0]) == pytest.approx(expected, rel=0.2)
+    assert np.median(np.abs(centres[sliding, 1])) < 0.1 * expected
+    # Before the pusher reaches it, the plate rests on its supports' centre (its centre of mass).
+    untouched = centres[:np.argmax(np.linalg.norm(velocities[:, :2], axis=1) > 1e-5)]
+    assert len(untouched) > 10 and np.all(np.abs(untouched) < 0.05 * expected)
+
+
 def test_anisotropic_friction_turns_the_sliding_direction():
     """A slanted central push: the plate slides preferably along its low-friction axis."""
     p = params(angle=0.6)
