@@ -1,8 +1,10 @@
 """Shared simulated data for the loop's tests: one small testbed data set per injected effect, recorded
-once per test run without declared effects, and the loop's report on each, computed once. The data sets are shared
-by every pytest-xdist worker (the suite runs a test file per worker, and several files use the same data)."""
+once per test run without declared effects, and the loop's report on each, computed once. The data sets and the
+reports are shared by every pytest-xdist worker (the suite runs a test file per worker, and several files use the same
+data)."""
 
 import dataclasses
+import json
 
 import pytest
 
@@ -40,19 +42,18 @@ the mechanism check has nothing to compare. On clean data the loop now selects `
 
 CASES = {
     "clean": Case(Effects(), REAL_DIFFERENCES),
-    # The testbed's moved centre of mass redistributes the support's normal forces (pushjax.sim.effects): a
-    # shifted centre of friction, which cof_offset models alone and pressure_gradient together with its l.
-    "com_offset": Case(Effects(com_offset=(0.015, -0.01)), frozenset({"cof_offset", "pressure_gradient"})),
     "pressure": Case(Effects(pressure_rim=-4.0), frozenset({"limit_surface"})),
     "anisotropy": Case(Effects(friction_anisotropy=(1.0, 2.5)), frozenset({"anisotropic_friction"})),
     "table_tilt": Case(Effects(table_tilt_deg=6.0, table_tilt_azimuth_deg=60.0), frozenset({"table_tilt"})),
-    # Measured by the force sensor, not selected: the plain model gets the measured coefficient.
+    # Read by the force sensor (test_force.py); with the loop, in the two-effect case below.
     "pusher_friction": Case(Effects(pusher_friction=0.8), frozenset(), pusher_friction=0.8),
     "tracking_bias": Case(Effects(tracking_bias=(0.01, -0.006, 0.0)), frozenset({"frame_offset"})),
     # Outside the library: the motion-capture yaw is biased by 7 degrees, so every contact is annotated on
     # a turned outline. No effect turns the annotated geometry.
     "tracking_yaw_bias": Case(Effects(tracking_bias=(0.0, 0.0, 0.12)), frozenset()),
-    # Two at once: the force sensor measures the pusher friction, the selection must find the offset.
+    # Two at once: the force sensor measures the pusher friction, the selection must find the offset. The testbed's
+    # moved centre of mass redistributes the support's normal forces (pushjax.sim.effects): a shifted centre of
+    # friction, which cof_offset models alone and pressure_gradient together with its l.
     "com_offset_and_pusher_friction": Case(Effects(com_offset=(0.015, -0.01), pusher_friction=0.8),
                                            frozenset({"cof_offset", "pressure_gradient"}), pusher_friction=0.8),
 }
@@ -78,13 +79,13 @@ def record(tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def loop_report(record, tmp_path_factory):
-    """loop_report(name) -> (report.json content, workdir) of the loop on ``CASES[name]`` (run on first use)."""
-    reports = {}
+    """loop_report(name) -> (report.json content, workdir) of the loop on ``CASES[name]`` (run on first use, by
+    whichever worker asks first; ``tests/loop/test_report.py`` checks that report.json is the report)."""
+    shared = _shared_folder(tmp_path_factory)
 
     def get(name):
-        if name not in reports:
-            workdir = tmp_path_factory.mktemp(f"loop_{name}")
-            reports[name] = (close_loop(record(name), workdir, progress=False).report.as_dict(), workdir)
-        return reports[name]
+        workdir = shared / f"loop_report_{name}"
+        once_across_workers(workdir, lambda: close_loop(record(name), workdir, progress=False))
+        return json.loads((workdir / "report.json").read_text()), workdir
 
     return get

@@ -18,16 +18,27 @@ def run(*arguments):
                           capture_output=True, text=True, timeout=600)
 
 
+def first_pushes(root: Path, count: int, folder: Path) -> Path:
+    """``folder`` holding links to the first ``count`` push files below ``root``, in the same layout."""
+    for path in sorted(root.rglob("*.h5"))[:count]:
+        target = folder / path.relative_to(root)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.symlink_to(path)
+    return folder
+
+
 def test_writes_the_report(record, tmp_path):
-    # Two candidates keep it short; what the loop selects from the whole library is test_undeclared_effects.py's.
-    result = run(f"--data_dir={record('pressure')}", f"--workdir={tmp_path}", "--seed=3",
+    # Two candidates and a third of the pushes keep it short; what the loop selects from the whole library on all of
+    # them is test_undeclared_effects.py's.
+    pushes = first_pushes(record("pressure"), 40, tmp_path / "pushes")
+    result = run(f"--data_dir={pushes}", f"--workdir={tmp_path / 'out'}", "--seed=3",
                  "--effects=limit_surface,table_tilt")
     assert result.returncode == 0, result.stderr
-    report = json.loads((tmp_path / "report.json").read_text())
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
     assert report["selected"] == ["limit_surface"]  # the centre-loaded pressure: the exact surface's rim mode
     assert sorted(entry["effect"] for entry in report["ranking"]) == ["limit_surface", "table_tilt"]
     assert json.loads(result.stdout[:result.stdout.rindex("}") + 1])["selected"] == report["selected"]
-    assert (tmp_path / "report.md").is_file() and (tmp_path / "details.json").is_file()
+    assert (tmp_path / "out" / "report.md").is_file() and (tmp_path / "out" / "details.json").is_file()
 
 
 def test_missing_or_empty_data_dir_names_the_flag(tmp_path):
@@ -40,11 +51,7 @@ def test_missing_or_empty_data_dir_names_the_flag(tmp_path):
 
 
 def test_too_few_push_sequences_stop_with_one_line(record, tmp_path):
-    few = tmp_path / "few"
-    for path in sorted(record("clean").rglob("*.h5"))[:3]:
-        target = few / path.relative_to(record("clean"))
-        target.parent.mkdir(parents=True, exist_ok=True)
-        target.symlink_to(path)
+    few = first_pushes(record("clean"), 3, tmp_path / "few")
     result = run(f"--data_dir={few}", f"--workdir={tmp_path / 'out'}")
     assert result.returncode != 0 and "Traceback" not in result.stderr
     line = result.stderr.strip().splitlines()[-1]

@@ -8,6 +8,7 @@ force sensor (``limit_surface_shape``), and nothing else.
 """
 
 import dataclasses
+import json
 import math
 from pathlib import Path
 
@@ -107,6 +108,7 @@ def test_report_files_keep_every_key_and_byte(tmp_path):
         for name in ("report.json", "details.json", "report.md"):
             expected = EXPECTED / f"{'measured' if measured_friction else 'nominal'}_{name}"
             assert (workdir / name).read_text() == expected.read_text(), name
+        assert json.loads((workdir / "report.json").read_text()) == small_result(measured_friction).report.as_dict()
 
 
 def test_explained_is_the_test_error_within_the_noise_floor_interval():
