@@ -85,12 +85,20 @@ def test_conv_transpose_matches_flax_in_value_and_gradient(kernel_size, strides)
     inputs = jax.random.normal(jax.random.key(0), (2, 7, 5, 3))
     reference = nn.ConvTranspose(4, (kernel_size, kernel_size), strides=strides)
     ours = perception.ConvTranspose(4, (kernel_size, kernel_size), strides=strides)
-    variables = reference.init(jax.random.key(1), inputs)
-    assert jax.tree.map(jnp.shape, ours.init(jax.random.key(1), inputs)) == jax.tree.map(jnp.shape, variables)
-    np.testing.assert_allclose(ours.apply(variables, inputs), reference.apply(variables, inputs), atol=1e-5)
+    variables = jax.jit(reference.init)(jax.random.key(1), inputs)
 
-    def gradients(module):
-        return jax.grad(lambda v, x: jnp.sum(jnp.sin(module.apply(v, x))), argnums=(0, 1))(variables, inputs)
+    def shapes(tree):
+        return jax.tree.map(lambda leaf: leaf.shape, tree)
 
-    for ours_leaf, reference_leaf in zip(jax.tree.leaves(gradients(ours)), jax.tree.leaves(gradients(reference))):
+    assert shapes(jax.eval_shape(ours.init, jax.random.key(1), inputs)) == shapes(variables)
+
+    def outputs_and_gradients(module):
+        # Jitted: a case compiles one program per module instead of each of its operations, forward and backward.
+        return jax.jit(lambda v, x: (module.apply(v, x), jax.grad(
+            lambda v, x: jnp.sum(jnp.sin(module.apply(v, x))), argnums=(0, 1))(v, x)))(variables, inputs)
+
+    (ours_outputs, ours_gradients), (reference_outputs, reference_gradients) = (
+        outputs_and_gradients(ours), outputs_and_gradients(reference))
+    np.testing.assert_allclose(ours_outputs, reference_outputs, atol=1e-5)
+    for ours_leaf, reference_leaf in zip(jax.tree.leaves(ours_gradients), jax.tree.leaves(reference_gradients)):
         np.testing.assert_allclose(ours_leaf, reference_leaf, atol=1e-4, rtol=1e-5)
