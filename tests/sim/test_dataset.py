@@ -200,7 +200,7 @@ def test_plan_draws_distinct_pushes_and_checks_arguments(tmp_path):
             dataset.plan_pushes(tmp_path, **{"objects": ["rect1"], "surfaces": ["abs"], "pushes": 1, **arguments})
     for fields, message in [
         (dict(velocities=(0.0,)), "velocities"), (dict(accelerations=(-1.0,)), "accelerations"),
-        (dict(repeats=0), "repeats"), (dict(seed=-1), "seed"), (dict(support="ring"), "support"),
+        (dict(repeats=0), "repeats"), (dict(seed=-1), "seed"), (dict(support="feet"), "support"),
         (dict(start_poses="random"), "start_poses"), (dict(testbed="realistic"), "testbed"),
         (dict(effects={}), "effects"),
     ]:
