@@ -346,6 +346,10 @@ def sweep(
                     f"({metadata.get('identity')}); use a fresh work directory"
                 )
             start, state, _ = checkpointer.restore_latest(state)
+            if jax.device_count() == 1:
+                # Orbax returns arrays committed to the device, a fresh state's are not, and jax.jit keys its cache
+                # on that: uncommitted, a resumed sweep reuses the train step a fresh one compiled in this process.
+                state = jax.tree.map(lambda leaf: jnp.asarray(np.asarray(leaf)), state)
             if start > train_config.num_steps:
                 warnings.warn(
                     f"workdir: {workdir} holds a checkpoint at step {start}, past the requested num_steps "
