@@ -132,9 +132,9 @@ class Simulator:
         self._support_local, self._support_areas = scene.support_points(self.obj, support)
         # MuJoCo may swap the two geoms of a pair, so a pair is found by either.
         pair_geoms = np.stack([self.model.pair_geom1, self.model.pair_geom2], axis=1)
-        self._support_pairs = np.array([
-            int(np.flatnonzero((pair_geoms == self.model.geom(f"support{k}").id).any(axis=1))[0])
-            for k in range(len(self._support_local))])
+        self._support_of_geom = {int(self.model.geom(f"support{k}").id): k for k in range(len(self._support_local))}
+        self._support_pairs = np.array([int(np.flatnonzero((pair_geoms == geom).any(axis=1))[0])
+                                        for geom in self._support_of_geom])
         self._pusher_pairs = np.flatnonzero((pair_geoms == self.model.geom("pusher_tip").id).any(axis=1))
 
     def _settle(self) -> np.ndarray:
@@ -329,11 +329,10 @@ class Simulator:
         """[K] normal force of each support point on the table in the current state, N (0 where it does not
         touch)."""
         model, data = self.model, self.data
-        support_of_geom = {int(model.geom(f"support{k}").id): k for k in range(len(self._support_local))}
         forces, wrench = np.zeros(len(self._support_local)), np.zeros(6)
         for c in range(data.ncon):
             contact = data.contact[c]
-            k = support_of_geom.get(int(contact.geom1), support_of_geom.get(int(contact.geom2)))
+            k = self._support_of_geom.get(int(contact.geom1), self._support_of_geom.get(int(contact.geom2)))
             if k is not None:
                 mujoco.mj_contactForce(model, data, c, wrench)
                 forces[k] += wrench[0]
