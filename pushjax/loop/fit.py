@@ -182,18 +182,36 @@ def _optimise(scaled, masks, inputs, target, weight, scales, floors, steps, lear
 
 
 @functools.partial(jax.jit, static_argnames="exact")
-def _residual_jacobian(scaled, mask, inputs, target, scales, exact):
-    """Scaled residuals [N, 3] of one candidate and their Jacobian [N, 3, P] by the flat variables."""
+def _residual_jacobian(scaled, mask, inputs, target, scales, own, exact):
+    """Scaled residuals [N, 3] of one candidate and their Jacobian [N, 3, P] by the flat variables, computed for the
+    variables where ``own`` [P] is true (the candidate's own: the masked effects' variables have no effect) and zero
+    elsewhere."""
     flat, unravel = ravel_pytree(scaled)
 
     def residuals(flat):
         prediction = _FULL_MODELS[exact](_params_from_scaled(unravel(flat), mask, exact), inputs)
         return (prediction - target) / jnp.stack([scales[0], scales[0], scales[1]])
 
+    value = residuals(flat)
+
     # One forward-mode derivative per variable in sequence: jax.jacfwd's vmap over the basis gives some of the exact
-    # limit surface's columns as zeros under jit (jax 0.10.2, XLA:CPU), one at a time is right.
-    columns = jax.lax.map(lambda basis: jax.jvp(residuals, (flat,), (basis,))[1], jnp.eye(len(flat), dtype=flat.dtype))
-    return residuals(flat), jnp.moveaxis(columns, 0, -1)
+    # limit surface's columns as zeros under jit (jax 0.10.2, XLA:CPU), one at a time is right. A variable the
+    # candidate does not own skips its solve (one compiled program for every candidate of a family).
+    def column(args):
+        basis, needed = args
+        return jax.lax.cond(needed, lambda: jax.jvp(residuals, (flat,), (basis,))[1], lambda: jnp.zeros_like(value))
+
+    columns = jax.lax.map(column, (jnp.eye(len(flat), dtype=flat.dtype), own))
+    return value, jnp.moveaxis(columns, 0, -1)
+
+
+def _own_variables(scaled, candidate: Sequence[str]) -> np.ndarray:
+    """[P] whether each flat variable of ``scaled`` (in :func:`ravel_pytree`'s order) belongs to the candidate's
+    effects."""
+    names = list(scaled)
+    owner, _ = ravel_pytree({name: {key: np.full(np.shape(value), i, np.float32) for key, value in values.items()}
+                             for i, (name, values) in enumerate(scaled.items())})
+    return np.isin(np.asarray(owner).astype(int), [names.index(name) for name in candidate])
 
 
 @functools.partial(jax.jit, static_argnames="exact")
@@ -291,7 +309,8 @@ def fit_effects(
 
 def _physical_with_std(scaled, mask, batch, scales, floors, sequence, candidate, exact):
     residual, jacobian = jax.device_get(_residual_jacobian(scaled, jnp.asarray(mask), batch.inputs, batch.target,
-                                                           scales, exact))
+                                                           scales, jnp.asarray(_own_variables(scaled, candidate)),
+                                                           exact))
     floors = np.asarray(floors, np.float64)
     used = sequence >= 0
     residual, jacobian, sequence = residual[used].astype(np.float64), jacobian[used].astype(np.float64), sequence[used]

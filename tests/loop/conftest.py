@@ -10,7 +10,7 @@ import pytest
 
 from tests.conftest import _shared_folder, once_across_workers
 
-from pushjax.loop import close_loop
+from pushjax.loop import LoopSettings, close_loop
 from pushjax.sim.dataset import RecordingSettings, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
@@ -60,6 +60,9 @@ CASES = {
 PUSHES = 120
 """Pushes per data set unless the case says otherwise: rect1 on polyurethane at 20 mm/s (quasi-static), drawn
 from the MIT grid."""
+STRIDE = LoopSettings.horizon
+"""Windows of the tests' loop runs one after the other instead of overlapping by half (the default): half the windows
+to fit, from the same push sequences (the unit every test and interval of the loop counts)."""
 
 
 @pytest.fixture(scope="session")
@@ -85,7 +88,8 @@ def loop_report(record, tmp_path_factory):
 
     def get(name):
         workdir = shared / f"loop_report_{name}"
-        once_across_workers(workdir, lambda: close_loop(record(name), workdir, progress=False))
+        once_across_workers(workdir, lambda: close_loop(record(name), workdir, LoopSettings(stride=STRIDE),
+                                                        progress=False))
         return json.loads((workdir / "report.json").read_text()), workdir
 
     return get

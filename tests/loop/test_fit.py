@@ -11,6 +11,8 @@ from pushjax.loop.windows import build_examples, split_by_sequence
 from pushjax.mit.files import iter_pushes
 from pushjax.physics.effects import EFFECT_NAMES
 
+from .conftest import STRIDE
+
 TRUE = {"cof_offset": {"offset": np.array([0.008, -0.004])},
         "friction_ratio": {"log_scale": np.array(np.log(1.4))}}
 
@@ -18,7 +20,7 @@ TRUE = {"cof_offset": {"offset": np.array([0.008, -0.004])},
 @pytest.fixture(scope="module")
 def synthetic(record):
     """Examples whose targets follow cof_offset + friction_ratio, plus 0.2 mm / 0.2 deg noise."""
-    examples, _ = build_examples(iter_pushes(record("clean")))
+    examples, _ = build_examples(iter_pushes(record("clean")), stride=STRIDE)
     truth = fit.FitResult(effects=tuple(TRUE), params=TRUE, physical={}, loss=0.0)
     target = fit.predict([truth], examples)[0]
     noise = np.random.default_rng(0).normal(size=target.shape) * np.array([2e-4, 2e-4, np.radians(0.2)])
@@ -98,7 +100,7 @@ def _two_surfaces(examples, scales):
 
 
 def test_an_effect_whose_parameters_flip_between_surfaces_is_a_knob(record):
-    examples, _ = build_examples(iter_pushes(record("clean")))
+    examples, _ = build_examples(iter_pushes(record("clean")), stride=STRIDE)
     settings = fit.FitSettings(steps=150)
     start = {"pusher_friction": {"log_scale": np.array(0.0)}}
     same = select.check_mechanism(_two_surfaces(examples, {"abs": 0.5, "pu": 0.5}), ("pusher_friction",),
