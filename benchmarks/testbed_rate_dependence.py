@@ -9,6 +9,11 @@ plate's rotation until the pusher stops (the slide after it is ``inertia``'s, a 
 rotation at the slowest speed (1 for a rate-independent testbed).
 
     python benchmarks/testbed_rate_dependence.py [--objects rect1:pu,tri2:delrin,ellip3:delrin] [--velocities 15,20,40]
+        [--support_d0 0.1] [--tip_stiffness 100] [--impratio 100]
+
+The last three replace the testbed's constants (``pushjax.sim.scene``'s ``SUPPORT_SOLIMP[0]``, ``TIP_STIFFNESS`` with
+its critical damping, ``IMPRATIO``; the defaults are the testbed's) in this process, to ask which of them the rate
+dependence comes from.
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ import argparse
 import numpy as np
 
 from pushjax.mit.protocol import PushParams
+from pushjax.sim import scene
 from pushjax.sim.push import simulate_push
 
 PUSHES = ((0.2, 0.0), (0.8, 0.3), (0.3, -0.3))
@@ -43,7 +49,14 @@ def main():
     parser.add_argument("--objects", default="rect1:pu,tri2:delrin,ellip3:delrin",
                         help="comma-separated object:surface pairs")
     parser.add_argument("--velocities", default="15,20,40", help="comma-separated push speeds, mm/s")
+    parser.add_argument("--support_d0", type=float, default=scene.SUPPORT_SOLIMP[0],
+                        help="the support contacts' impedance at zero penetration (MuJoCo solimp d0)")
+    parser.add_argument("--tip_stiffness", type=float, default=scene.TIP_STIFFNESS, help="the pusher tip's spring, N/m")
+    parser.add_argument("--impratio", type=float, default=scene.IMPRATIO, help="MuJoCo's frictional impedance ratio")
     args = parser.parse_args()
+    scene.SUPPORT_SOLIMP = (args.support_d0, *scene.SUPPORT_SOLIMP[1:])
+    scene.TIP_STIFFNESS, scene.IMPRATIO = args.tip_stiffness, args.impratio
+    scene.TIP_DAMPING = 2 * (scene.TIP_STIFFNESS * scene.TIP_MASS) ** 0.5
     pairs = [pair.split(":") for pair in args.objects.split(",")]
     if any(len(pair) != 2 for pair in pairs):
         parser.error(f"--objects: expected object:surface pairs, got {args.objects!r}")
