@@ -325,18 +325,30 @@ class Simulator:
         """[K, 2] the support points in the tracked frame, m (:func:`pushjax.sim.scene.support_points`)."""
         return self._support_local.copy()
 
-    def support_normal_forces(self) -> np.ndarray:
-        """[K] normal force of each support point on the table in the current state, N (0 where it does not
-        touch)."""
+    def support_forces(self) -> np.ndarray:
+        """[K, 2] the size of the table's normal and of its tangential (friction) force on each support point in the
+        current state, N (each summed over the point's contacts; 0 where it does not touch)."""
         model, data = self.model, self.data
-        forces, wrench = np.zeros(len(self._support_local)), np.zeros(6)
+        normal, friction = np.zeros((len(self._support_local), 3)), np.zeros((len(self._support_local), 3))
+        wrench = np.zeros(6)
         for c in range(data.ncon):
             contact = data.contact[c]
             k = self._support_of_geom.get(int(contact.geom1), self._support_of_geom.get(int(contact.geom2)))
             if k is not None:
                 mujoco.mj_contactForce(model, data, c, wrench)
-                forces[k] += wrench[0]
-        return forces
+                frame = contact.frame.reshape(3, 3)  # rows: the contact's normal and its two tangents, world axes
+                normal[k] += wrench[0] * frame[0]
+                friction[k] += wrench[1] * frame[1] + wrench[2] * frame[2]
+        return np.stack([np.linalg.norm(normal, axis=1), np.linalg.norm(friction, axis=1)], axis=1)
+
+    def support_normal_forces(self) -> np.ndarray:
+        """[K] normal force of each support point on the table in the current state, N (0 where it does not
+        touch)."""
+        return self.support_forces()[:, 0]
+
+    def support_sliding_speeds(self) -> np.ndarray:
+        """[K] sliding speed of each support point over the table in the current state, m/s."""
+        return self._support_motion()[1]
 
     def object_velocity(self) -> np.ndarray:
         """[3] the tracked frame's velocity along its own axes (m/s) and its yaw rate (rad/s) in the current state."""

@@ -198,6 +198,28 @@ def test_the_pushing_force_moves_the_load_to_the_leading_edge(surface):
     assert len(untouched) > 10 and np.all(np.abs(untouched) < 0.05 * expected)
 
 
+def test_sliding_supports_obey_coulombs_law_at_every_speed():
+    # Each support of a turning plate slides at its own speed (fastest far from the centre of rotation); the table's
+    # friction on it is mu times its normal force whatever that speed, as in the planar models: the soft contacts
+    # regularise only below about half a millimetre per second (benchmarks/testbed_rate_dependence.py).
+    sim = Simulator("rect1", "pu")
+    ratios, speeds = [], []
+
+    def record(simulator):
+        forces, sliding = simulator.support_forces(), simulator.support_sliding_speeds()
+        touching = forces[:, 0] > 0
+        ratios.extend(forces[touching, 1] / forces[touching, 0])
+        speeds.extend(sliding[touching])
+
+    sim.run(params(surface="pu", point=0.2), on_step=record)
+    ratios, speeds = np.array(ratios) / SURFACES["pu"].object_friction, np.array(speeds)
+    slow, fast = (speeds > 1e-3) & (speeds < 8e-3), speeds > 15e-3
+    assert slow.sum() > 100 and fast.sum() > 100
+    for band in (slow, fast):
+        assert np.median(ratios[band]) == pytest.approx(1.0, abs=0.02)
+    np.testing.assert_allclose(sim.support_forces()[:, 0], sim.support_normal_forces())
+
+
 def test_anisotropic_friction_turns_the_sliding_direction():
     """A slanted central push: the plate slides preferably along its low-friction axis."""
     p = params(angle=0.6)
