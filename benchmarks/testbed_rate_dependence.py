@@ -13,7 +13,9 @@ speed:
   table's coefficient (1: Coulomb), over the supports sliding faster than :data:`SLIDING`;
 * where the load sits: the median move of the centre of the supports' normal forces from where it rests, along the
   plate's motion, over the load transfer ``mu * thickness / 2`` (the pushing force, at half the plate's height, tips
-  the load forwards).
+  the load forwards);
+* how the load spreads: the median of its mean squared distance from its centre over the same at rest (above 1: the
+  load moved outwards, which makes the plate harder to turn).
 
     python benchmarks/testbed_rate_dependence.py [--objects rect1:pu,tri2:delrin,ellip3:delrin] [--velocities 15,20,40]
         [--support_d0 0.1] [--tip_stiffness 100] [--impratio 100]
@@ -41,14 +43,15 @@ SLIDING = 5e-4
 """Sliding speed (m/s) from which a support counts as sliding: below it MuJoCo's soft friction is still building up."""
 
 
-def measure(obj: str, surface: str, velocity: float) -> tuple[list[float], float, float]:
+def measure(obj: str, surface: str, velocity: float) -> tuple[list[float], float, float, float]:
     """(the rotation of each of :data:`PUSHES` until the pusher stops, degrees; the supports' median friction over
-    Coulomb's; the load's median forward shift over ``mu * thickness / 2``) at ``velocity`` mm/s."""
+    Coulomb's; the load's median forward shift over ``mu * thickness / 2``; the load's median spread over its spread
+    at rest) at ``velocity`` mm/s."""
     simulator = Simulator(obj, surface)
     mu = SURFACES[surface].object_friction
     transfer = mu * get_object(obj).thickness / 2
     points = simulator.support_points
-    friction, forward, rest = [], [], [np.zeros(2)]
+    friction, forward, spread, rest = [], [], [], [np.zeros(2), 1.0]
 
     def record(sim: Simulator) -> None:
         forces, speeds = sim.support_forces(), sim.support_sliding_speeds()
@@ -56,12 +59,15 @@ def measure(obj: str, surface: str, velocity: float) -> tuple[list[float], float
         friction.extend(forces[sliding, 1] / (mu * forces[sliding, 0]))
         if forces[:, 0].sum() == 0:
             return
-        centre = forces[:, 0] @ points / forces[:, 0].sum()
+        load = forces[:, 0] / forces[:, 0].sum()
+        centre = load @ points
+        square = load @ np.sum((points - centre) ** 2, axis=1)
         motion = sim.object_velocity()[:2]
         if np.linalg.norm(motion) < 1e-5:
-            rest[0] = centre  # where the load sits before the pusher reaches the plate
+            rest[:] = centre, square  # how the load sits before the pusher reaches the plate
         elif np.linalg.norm(motion) > 0.3e-3 * velocity:
             forward.append((centre - rest[0]) @ motion / np.linalg.norm(motion) / transfer)
+            spread.append(square / rest[1])
 
     turned = []
     for point, angle in PUSHES:
@@ -71,7 +77,7 @@ def measure(obj: str, surface: str, velocity: float) -> tuple[list[float], float
         tip, pose = recording.tip_pose, recording.true_object_pose
         stop = np.flatnonzero(np.linalg.norm(np.diff(tip[:, 1:3], axis=0), axis=1) > 1e-7)[-1] + 1
         turned.append(float(np.degrees(pose[stop, 3] - pose[0, 3])))
-    return turned, float(np.median(friction)), float(np.median(forward))
+    return turned, float(np.median(friction)), float(np.median(forward)), float(np.median(spread))
 
 
 def main():
@@ -92,15 +98,16 @@ def main():
         parser.error(f"--objects: expected object:surface pairs, got {args.objects!r}")
     velocities = sorted(float(value) for value in args.velocities.split(","))
     print("| object | surface | push speed mm/s | rotation of the pushes, deg | over the rotation at the slowest speed "
-          "| supports' friction / Coulomb's | load's forward shift / (mu thickness / 2) |")
-    print("|---|---|---:|---|---|---:|---:|")
+          "| supports' friction / Coulomb's | load's forward shift / (mu thickness / 2) | load's spread / at rest |")
+    print("|---|---|---:|---|---|---:|---:|---:|")
     for obj, surface in pairs:
         slowest = None
         for velocity in velocities:
-            turned, friction, forward = measure(obj, surface, velocity)
+            turned, friction, forward, spread = measure(obj, surface, velocity)
             slowest = slowest or turned
             print(f"| {obj} | {surface} | {velocity:g} | {', '.join(f'{r:.2f}' for r in turned)} | "
-                  f"{', '.join(f'{r / s:.3f}' for r, s in zip(turned, slowest))} | {friction:.3f} | {forward:.2f} |",
+                  f"{', '.join(f'{r / s:.3f}' for r, s in zip(turned, slowest))} | {friction:.3f} | {forward:.2f} | "
+                  f"{spread:.3f} |",
                   flush=True)
 
 
