@@ -32,7 +32,10 @@ def main():
     args = parser.parse_args()
     if not args.data.is_dir():
         parser.error(f"--data: {str(args.data)!r} is not a directory")
-    examples = build_examples(iter_pushes(args.data))[0]
+    try:
+        examples = build_examples(iter_pushes(args.data))[0]
+    except ValueError as error:
+        parser.error(f"--data: {error}")
     speeds = np.asarray(examples.variables["push velocity"], float)
     if args.speed is not None:
         keep = speeds == args.speed

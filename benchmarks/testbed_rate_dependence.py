@@ -31,7 +31,7 @@ import argparse
 
 import numpy as np
 
-from pushjax.geometry import get_object
+from pushjax.geometry import OBJECT_NAMES, get_object
 from pushjax.mit.protocol import PushParams
 from pushjax.sim import scene
 from pushjax.sim.push import Simulator
@@ -94,9 +94,15 @@ def main():
     scene.TIP_STIFFNESS, scene.IMPRATIO = args.tip_stiffness, args.impratio
     scene.TIP_DAMPING = 2 * (scene.TIP_STIFFNESS * scene.TIP_MASS) ** 0.5
     pairs = [pair.split(":") for pair in args.objects.split(",")]
-    if any(len(pair) != 2 for pair in pairs):
-        parser.error(f"--objects: expected object:surface pairs, got {args.objects!r}")
-    velocities = sorted(float(value) for value in args.velocities.split(","))
+    if any(len(pair) != 2 or pair[0] not in OBJECT_NAMES or pair[1] not in SURFACES for pair in pairs):
+        parser.error(f"--objects: expected object:surface pairs (objects {', '.join(OBJECT_NAMES)}; surfaces "
+                     f"{', '.join(SURFACES)}), got {args.objects!r}")
+    try:
+        velocities = sorted(float(value) for value in args.velocities.split(","))
+    except ValueError:
+        velocities = []
+    if not velocities or min(velocities) <= 0:
+        parser.error(f"--velocities: expected comma-separated positive speeds in mm/s, got {args.velocities!r}")
     print("| object | surface | push speed mm/s | rotation of the pushes, deg | over the rotation at the slowest speed "
           "| supports' friction / Coulomb's | load's forward shift / (mu thickness / 2) | load's spread / at rest |")
     print("|---|---|---:|---|---|---:|---:|---:|")
