@@ -3,6 +3,8 @@
 import functools
 import os
 import pathlib
+import subprocess
+import sys
 
 import filelock
 import pytest
@@ -12,12 +14,32 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 SHARED = pathlib.Path(__file__).resolve().parents[1].parent / "shared"
 
 
+FAST_COMPILE_XLA_FLAG = "--xla_cpu_use_fusion_emitters=false"
+"""XLA:CPU's older loop emitters instead of its fusion emitters: the same programs compile in about half the time
+and run as fast (BUILD.md, issue 34), and about half of the suite's CPU time is compilation."""
+
+
+def _use_fast_compile_flag() -> None:
+    """Adds :data:`FAST_COMPILE_XLA_FLAG` to ``XLA_FLAGS`` (which the workers and the tests' subprocesses inherit)
+    where the installed jaxlib knows it: XLA aborts the process on a flag it does not know, and a later jaxlib may
+    drop this one. Checked once, in the process that starts the workers."""
+    flags = os.environ.get("XLA_FLAGS", "")
+    if "xla_cpu_use_fusion_emitters" in flags or os.environ.get("PYTEST_XDIST_WORKER"):
+        return
+    probe = subprocess.run([sys.executable, "-c", "import jax; jax.numpy.zeros(1).block_until_ready()"],
+                           env={**os.environ, "XLA_FLAGS": f"{flags} {FAST_COMPILE_XLA_FLAG}".strip(),
+                                "JAX_PLATFORMS": "cpu"}, capture_output=True, timeout=120)
+    if probe.returncode == 0:
+        os.environ["XLA_FLAGS"] = f"{flags} {FAST_COMPILE_XLA_FLAG}".strip()
+
+
 def pytest_configure(config):
-    """One persistent XLA compilation cache for every pytest-xdist worker (in pytest's cache folder), set before
-    anything compiles: the loop's data sets compile the same fitting programs, the exact limit surface's in 10-20 s
+    """XLA's faster-compiling CPU emitters (:func:`_use_fast_compile_flag`), and one persistent XLA compilation cache
+    for every pytest-xdist worker (in pytest's cache folder), set before anything compiles: the loop's data sets compile the same fitting programs, the exact limit surface's in 10-20 s
     each, and without the cache every data set compiles them again. The tests' subprocesses (binaries, notebook
     kernels) get it through the environment, e.g. ``experiments.push_to_goal --scale=smoke`` the controller programs
     that tests/control/test_closed_loop.py compiles."""
+    _use_fast_compile_flag()
     if getattr(config, "cache", None) is None:
         return
     import jax
