@@ -11,6 +11,7 @@ import pytest
 from tests.conftest import _shared_folder, once_across_workers
 
 from pushjax.loop import LoopSettings, close_loop
+from pushjax.loop.fit import FitSettings
 from pushjax.sim.dataset import RecordingSettings, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
@@ -63,6 +64,9 @@ from the MIT grid."""
 STRIDE = LoopSettings.horizon
 """Windows of the tests' loop runs one after the other instead of overlapping by half (the default): half the windows
 to fit, from the same push sequences (the unit every test and interval of the loop counts)."""
+FIT = FitSettings(steps=150, warm_steps=50)
+"""Half the default Adam steps in the tests' fits (the defaults are the benchmarks'): on these data sets every loop run
+selects the same effects as with the defaults and its test error moves by at most 0.5 points (issue 34)."""
 
 
 @pytest.fixture(scope="session")
@@ -88,7 +92,7 @@ def loop_report(record, tmp_path_factory):
 
     def get(name):
         workdir = shared / f"loop_report_{name}"
-        once_across_workers(workdir, lambda: close_loop(record(name), workdir, LoopSettings(stride=STRIDE),
+        once_across_workers(workdir, lambda: close_loop(record(name), workdir, LoopSettings(stride=STRIDE, fit=FIT),
                                                         progress=False))
         return json.loads((workdir / "report.json").read_text()), workdir
 

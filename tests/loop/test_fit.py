@@ -11,7 +11,7 @@ from pushjax.loop.windows import build_examples, split_by_sequence
 from pushjax.mit.files import iter_pushes
 from pushjax.physics.effects import EFFECT_NAMES
 
-from .conftest import STRIDE
+from .conftest import FIT, STRIDE
 
 TRUE = {"cof_offset": {"offset": np.array([0.008, -0.004])},
         "friction_ratio": {"log_scale": np.array(np.log(1.4))}}
@@ -52,7 +52,7 @@ absorbs, so with friction_ratio either one is the true model (which one wins dep
 
 def test_forward_selection_adds_both_effects_and_stops(synthetic):
     split = splits.split(synthetic, len(EFFECT_NAMES), seed=1)
-    selection = select.select_effects(split)
+    selection = select.select_effects(split, settings=FIT)
     assert len(selection.selected) == 2 and "friction_ratio" in selection.selected
     shift = next(effect for effect in selection.selected if effect != "friction_ratio")
     assert shift in CENTRE_SHIFTS
