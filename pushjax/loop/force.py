@@ -66,7 +66,7 @@ def sliding_friction(push: Push, obj: PushObject, noise: np.ndarray) -> float:
     material = planar.rotate(arm, -pose[:, 2])
     carried = pose[lag:, :2] + planar.rotate(material[:-lag], pose[lag:, 2]) - (pose[:-lag, :2] + arm[:-lag])
     slip = tip[lag:] - tip[:-lag] - carried
-    along = _moving_average((slip[:, 0] * normal[:-lag, 1] - slip[:, 1] * normal[:-lag, 0])[:, None], lag)[:, 0]
+    along = _moving_average(_tangential(slip, normal[:-lag])[:, None], lag)[:, 0]
     local = _moving_average(material, lag)
     migration = np.linalg.norm(local[lag:] - local[:-lag], axis=1)
     # Tracking noise of the touched point (object position, and yaw times the lever arm; the tip's adds alike), on a
@@ -80,7 +80,7 @@ def sliding_friction(push: Push, obj: PushObject, noise: np.ndarray) -> float:
                     & (migration > threshold))
     force = push.wrench[:, :2]
     normal_force = np.sum(force * normal, axis=1)
-    tangential_force = np.abs(force[:, 0] * normal[:, 1] - force[:, 1] * normal[:, 0])
+    tangential_force = np.abs(_tangential(force, normal))
     loaded = normal_force > MIN_NORMAL_FORCE_SHARE * max(float(np.max(normal_force, initial=0.0)), 1e-9)
     used = slide & loaded
     if np.count_nonzero(used) < MIN_SLIDING_SAMPLES:
@@ -134,6 +134,11 @@ def window_wrenches(push: Push, obj: PushObject, starts: np.ndarray, ends: np.nd
         if np.any(inside):
             wrenches[k] = local[start:end][inside].mean(axis=0)
     return wrenches
+
+
+def _tangential(vectors: np.ndarray, normal: np.ndarray) -> np.ndarray:
+    """[T] the signed component of [T, 2] ``vectors`` along the tangent of the [T, 2] unit ``normal`` (turned -90°)."""
+    return vectors[:, 0] * normal[:, 1] - vectors[:, 1] * normal[:, 0]
 
 
 def _moving_average(values: np.ndarray, width: int) -> np.ndarray:
