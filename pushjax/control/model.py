@@ -31,6 +31,8 @@ class PushModel:
       mu: [] pusher-object friction coefficient.
       radius: [] pusher radius, m.
       params: {effect: {name: array}} of the composed effects ({} for plain Lynch).
+      support: the object's support (:func:`pushjax.physics.rollout.object_support`), which the exact limit
+        surface (``limit_surface``) needs; None for the other models.
       effects: names of the composed effects (static; () is plain Lynch).
     """
 
@@ -39,6 +41,7 @@ class PushModel:
     mu: jax.Array
     radius: jax.Array
     params: dict
+    support: rollout.Support | None = None
     effects: tuple[str, ...] = flax.struct.field(pytree_node=False, default=())
 
 
@@ -69,11 +72,13 @@ def make_model(obj: PushObject | str, mu: float = 0.25, l: float | None = None, 
             raise ValueError(f"params: {name} has no parameter(s) {', '.join(extra)}; it has {', '.join(full[name])}")
         full[name] = {**full[name], **values}
     full = jax.tree_util.tree_map(lambda value: jnp.asarray(value, dtype), full)
+    exact = any(effects_lib.EFFECTS[name].solve is not None for name in effects)
     return PushModel(shape=outline_jax.outline(obj, dtype), l=jnp.asarray(l, dtype), mu=jnp.asarray(mu, dtype),
-                     radius=jnp.asarray(PUSHER_RADIUS, dtype), params=full, effects=effects)
+                     radius=jnp.asarray(PUSHER_RADIUS, dtype), params=full,
+                     support=rollout.object_support(obj, dtype) if exact else None, effects=effects)
 
 
 def predict(model: PushModel, pose, pusher_path) -> rollout.Rollout:
     """The model's rollout from `pose` [3] (x m, y m, yaw rad) along `pusher_path` [T + 1, 2] (world, m)."""
     return rollout.rollout(model.shape, pose, pusher_path, model.l, model.mu, model.params, effects=model.effects,
-                           radius=model.radius)
+                           radius=model.radius, support=model.support)

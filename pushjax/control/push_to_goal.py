@@ -54,10 +54,6 @@ def model_effects(name: str) -> tuple[str, ...]:
         raise ValueError(f"model {name!r}: expected 'lynch' or 'lynch+<effect>+...'")
     effects = tuple(parts[1:])
     effects_lib.init_params(effects)
-    needs_support = [effect for effect in effects if effects_lib.EFFECTS[effect].solve is not None]
-    if needs_support:
-        raise ValueError(f"model {name!r}: {', '.join(needs_support)} needs the support's points, which the rollout "
-                         f"does not pass; use effects of {', '.join(effects_lib.ELLIPSOID_EFFECTS)}")
     return effects
 
 

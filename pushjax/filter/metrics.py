@@ -55,7 +55,7 @@ def simulate(system: models.System, true_state, pusher_paths):
     def one(state, path):
         return rollout.rollout(system.shape, state[:3], path, system.l * jnp.exp(state[4]),
                                system.mu * jnp.exp(state[3]), system.params, effects=system.effects,
-                               radius=system.radius).poses
+                               radius=system.radius, support=system.support).poses
 
     return jax.jit(jax.vmap(one))(jnp.asarray(true_state, system.l.dtype), jnp.asarray(pusher_paths, system.l.dtype))
 

@@ -53,6 +53,8 @@ class System:
       measurement_std: [3] standard deviation of a pose measurement (x m, y m, yaw rad).
       radius: [] pusher radius, m.
       params: the composed effects' parameters ({} for plain Lynch).
+      support: the object's support (:func:`pushjax.physics.rollout.object_support`) when an effect needs it (the
+        exact limit surface), else None.
       effects: names of the composed effects (static).
     """
 
@@ -63,6 +65,7 @@ class System:
     measurement_std: jax.Array
     radius: jax.Array
     params: dict
+    support: rollout.Support | None = None
     effects: tuple[str, ...] = flax.struct.field(pytree_node=False, default=())
 
 
@@ -97,10 +100,12 @@ def make_system(obj: PushObject | str, mu: float = 0.25, l: float | None = None,
         raise ValueError(f"mu, l: expected positive nominal values, got {mu}, {l}")
     effects = tuple(effects)
     params = effects_lib.init_params(effects) if params is None else params
+    exact = any(effects_lib.EFFECTS[name].solve is not None for name in effects)
     return System(shape=outline_jax.outline(obj, dtype, ellipse_points), l=jnp.asarray(l, dtype),
                   mu=jnp.asarray(mu, dtype), process_std=jnp.asarray(process_std, dtype),
                   measurement_std=jnp.asarray(measurement_std, dtype), radius=jnp.asarray(PUSHER_RADIUS, dtype),
-                  params=jax.tree_util.tree_map(lambda x: jnp.asarray(x, dtype), params), effects=effects)
+                  params=jax.tree_util.tree_map(lambda x: jnp.asarray(x, dtype), params),
+                  support=rollout.object_support(obj, dtype) if exact else None, effects=effects)
 
 
 def transition(system: System, state, pusher, increment):
@@ -109,7 +114,7 @@ def transition(system: System, state, pusher, increment):
     mu = system.mu * jnp.exp(latents[0])
     l = system.l * jnp.exp(latents[1])
     new_pose, _ = rollout.step(effects_lib.compose(system.effects), system.params, system.shape, pose, pusher,
-                               increment, l, mu, system.radius)
+                               increment, l, mu, system.radius, support=system.support)
     return jnp.concatenate([new_pose, latents])
 
 

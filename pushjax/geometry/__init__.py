@@ -10,6 +10,7 @@ from pushjax.geometry.objects import (
     footprint_grid,
     get_object,
     limit_surface_ratio,
+    support,
     support_cells,
     support_feet,
 )

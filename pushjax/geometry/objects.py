@@ -276,6 +276,20 @@ def support_feet(obj: PushObject) -> tuple[np.ndarray, np.ndarray]:
     return points, loads / loads.sum()
 
 
+def support(obj: PushObject) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The support the exact limit surface (``limit_surface``) needs: the footprint's cells and its hull's corners.
+
+    Returns:
+      (points [K, 2] the cells of :func:`support_cells` then the corners of :func:`support_feet`, relative to the
+      uniform plate's centre of mass, object axes, m; area weights [K] (zero for the corners); corner loads [K]
+      (zero for the cells); the cells' patch radius, m).
+    """
+    cells, areas, patch_radius = support_cells(obj)
+    corners, loads = support_feet(obj)
+    return (np.concatenate([cells, corners]), np.concatenate([areas, np.zeros(len(corners))]),
+            np.concatenate([np.zeros(len(cells)), loads]), patch_radius)
+
+
 def _polygon_object(name: str, vertices) -> PushObject:
     vertices = np.asarray(vertices, dtype=np.float64)
     if shapely.Polygon(vertices).exterior.is_ccw is False:

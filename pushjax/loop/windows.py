@@ -9,7 +9,7 @@ displacement over the window against the object pose at ``t0`` (:func:`pushjax.g
 where the pusher stops short of the object, the contact it would make within :data:`LOOKAHEAD` further,
 with ``s = 0`` and no action), the pusher's speed and stop, the nominal limit-surface ratio of the
 object (uniform pressure), its footprint as support cells and its hull's corners as feet
-(:func:`pushjax.geometry.support_cells`, :func:`pushjax.geometry.support_feet`, for the exact limit surface) and a nominal pusher friction; its
+(:func:`pushjax.geometry.support`, for the exact limit surface) and a nominal pusher friction; its
 target is the displacement of the object's nominal centre of mass (the uniform plate's centroid in the
 tracked frame) and the change of yaw over the window.
 """
@@ -31,8 +31,7 @@ from pushjax.geometry import (
     annotate,
     get_object,
     limit_surface_ratio,
-    support_cells,
-    support_feet,
+    support,
 )
 from pushjax.loop.force import sliding_friction, window_wrenches
 from pushjax.mit.files import Push
@@ -291,11 +290,7 @@ def _annotate_object(name: str, rows: list[dict], pusher_friction: float) -> dic
     gap = np.where(annotated, np.sum((contact_world - tip0) * normal, axis=1) - PUSHER_RADIUS, 0.0)
     com0, com1 = planar.centre_of_mass(obj.centroid, pose0), planar.centre_of_mass(obj.centroid, pose1)
     count = len(pose0)
-    cells, cell_areas, patch_radius = support_cells(obj)
-    feet, feet_loads = support_feet(obj)
-    support_points = np.concatenate([cells, feet])
-    support_weights = np.concatenate([cell_areas, np.zeros(len(feet))])
-    support_feet_loads = np.concatenate([np.zeros(len(cells)), feet_loads])
+    support_points, support_weights, support_feet_loads, patch_radius = support(obj)
     yaw = pose0[:, 2]
     variables = {
         "push velocity": np.array([p.velocity for p in params]),

@@ -21,7 +21,10 @@ Each step is quasi-static with the pusher moving, so the corrections for the sli
 (``inertia``, ``friction_speed``) act only in the last step, with the pusher speed ``|last increment| /
 step_time`` and ``time_after_stop``. ``frame_offset`` sees the step's gap to the outline (a contact just
 beyond the step can be brought into it); ``friction_field`` the object's position; ``anisotropic_friction``
-and ``pressure_gradient`` its yaw.
+and ``pressure_gradient`` its yaw. ``limit_surface`` (the exact limit surface in place of Lynch's ellipsoid) needs
+the object's support, :func:`object_support`, passed as ``support``:
+
+    rollout(shape, pose, pusher_path, l, mu, params, effects=("limit_surface",), support=object_support("rect1"))
 
 :func:`straight_push` is the former NumPy entry point (one object, a straight push of equal increments,
 NumPy in and out), now a thin wrapper around :func:`rollout`.
@@ -38,10 +41,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from pushjax.geometry import outline_jax
-from pushjax.geometry.objects import PUSHER_RADIUS, PushObject, get_object, limit_surface_ratio
+from pushjax.geometry.objects import PUSHER_RADIUS, PushObject, get_object, limit_surface_ratio, support
 from pushjax.physics import effects as effects_lib
 
-__all__ = ["Rollout", "StepInfo", "rollout", "step", "straight_push"]
+__all__ = ["Rollout", "StepInfo", "Support", "object_support", "rollout", "step", "straight_push"]
 
 
 class StepInfo(NamedTuple):
@@ -70,6 +73,30 @@ class Rollout(NamedTuple):
     steps: StepInfo
 
 
+class Support(NamedTuple):
+    """An object's support for the exact limit surface (:func:`pushjax.geometry.support`), object axes relative to
+    the uniform plate's centre of mass.
+
+    Attributes:
+      points: [K, 2] support points, m.
+      weights: [K] their area weights (zero for the hull's corners).
+      feet: [K] the loads on the hull's corners (zero for the cells).
+      patch_radius: [] radius of a support's patch, m.
+    """
+
+    points: jax.Array
+    weights: jax.Array
+    feet: jax.Array
+    patch_radius: jax.Array
+
+
+def object_support(obj: PushObject | str, dtype=jnp.float32) -> Support:
+    """The :class:`Support` of `obj` (or its name)."""
+    obj = get_object(obj) if isinstance(obj, str) else obj
+    points, weights, feet, patch_radius = support(obj)
+    return Support(*(jnp.asarray(value, dtype) for value in (points, weights, feet, patch_radius)))
+
+
 def _rotate(vector, yaw):
     cos, sin = jnp.cos(yaw), jnp.sin(yaw)
     return jnp.stack([cos * vector[..., 0] - sin * vector[..., 1], sin * vector[..., 0] + cos * vector[..., 1]],
@@ -83,7 +110,8 @@ def _safe_norm(vector):
 
 
 def step(predict, params, shape: outline_jax.Outline, pose, pusher, increment, l, mu,
-         radius=PUSHER_RADIUS, step_time=1.0, time_after_stop=0.0) -> tuple[jax.Array, StepInfo]:
+         radius=PUSHER_RADIUS, step_time=1.0, time_after_stop=0.0,
+         support: Support | None = None) -> tuple[jax.Array, StepInfo]:
     """One step of a rollout: annotate the contact where the object is, predict, move the object.
 
     Args:
@@ -98,6 +126,7 @@ def step(predict, params, shape: outline_jax.Outline, pose, pusher, increment, l
       radius: [] pusher radius, m.
       step_time: [] duration of the step, s (only for the pusher speed of a slide after a stop).
       time_after_stop: [] time from the pusher's stop at the step's end to the end of the window, s.
+      support: the object's :class:`Support` (needed by ``limit_surface``; None: unknown).
 
     Returns:
       ([3] the pose after the step, the step's :class:`StepInfo`).
@@ -113,7 +142,9 @@ def step(predict, params, shape: outline_jax.Outline, pose, pusher, increment, l
     inputs = effects_lib.PushInputs.create(
         contact=contact, normal=normal, action=action, l=l, mu=mu, s=touches.astype(pose.dtype),
         pusher_motion=increment, gap=local.gap, object_yaw=yaw,
-        push_speed=_safe_norm(increment) / step_time, time_after_stop=time_after_stop, object_position=com)
+        push_speed=_safe_norm(increment) / step_time, time_after_stop=time_after_stop, object_position=com,
+        **({} if support is None else {"support_points": support.points, "support_weights": support.weights,
+                                       "support_feet": support.feet, "patch_radius": support.patch_radius}))
     twist = predict(params, inputs)
     new_yaw = yaw + twist[2]
     new_com = com + twist[:2]
@@ -124,7 +155,8 @@ def step(predict, params, shape: outline_jax.Outline, pose, pusher, increment, l
 
 @functools.partial(jax.jit, static_argnames=("effects",))
 def rollout(shape: outline_jax.Outline, object_pose, pusher_path, l, mu, params=None, *,
-            effects: Sequence[str] = (), radius=PUSHER_RADIUS, step_time=1.0, time_after_stop=0.0) -> Rollout:
+            effects: Sequence[str] = (), radius=PUSHER_RADIUS, step_time=1.0, time_after_stop=0.0,
+            support: Support | None = None) -> Rollout:
     """Object poses along a pusher path predicted by the pushing model, one step per path segment.
 
     Args:
@@ -139,12 +171,16 @@ def rollout(shape: outline_jax.Outline, object_pose, pusher_path, l, mu, params=
       radius: [] pusher radius, m.
       step_time: [] duration of one step, s (the pusher speed of the slide after the stop).
       time_after_stop: [] time from the pusher's stop (the path's end) to the end of the rollout, s.
+      support: the object's :class:`Support` (:func:`object_support`); needed by ``limit_surface``.
 
     Returns:
       The :class:`Rollout`: poses [T + 1, 3] and the steps' :class:`StepInfo` [T, ...].
     """
     effects = tuple(effects)
     predict = effects_lib.compose(effects)
+    if support is None and any(effects_lib.EFFECTS[name].solve is not None for name in effects):
+        raise ValueError(f"support: effects {effects} include the exact limit surface, which needs the object's "
+                         "support (rollout.object_support(obj))")
     params = effects_lib.init_params(effects) if params is None else params
     pusher_path = jnp.asarray(pusher_path)
     if pusher_path.ndim != 2 or pusher_path.shape[-1] != 2 or pusher_path.shape[0] < 2:
@@ -158,7 +194,8 @@ def rollout(shape: outline_jax.Outline, object_pose, pusher_path, l, mu, params=
 
     def body(pose, inputs):
         pusher, increment, stop_time = inputs
-        new_pose, info = step(predict, params, shape, pose, pusher, increment, l, mu, radius, step_time, stop_time)
+        new_pose, info = step(predict, params, shape, pose, pusher, increment, l, mu, radius, step_time, stop_time,
+                              support)
         return new_pose, (new_pose, info)
 
     _, (poses, infos) = jax.lax.scan(body, pose, (starts, increments, stop_times))

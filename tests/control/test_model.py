@@ -32,3 +32,15 @@ def test_predict_is_the_rollout_with_the_models_effects():
     np.testing.assert_allclose(got, expected)
     plain = model.predict(model.make_model("rect1"), jnp.zeros(3), path).poses
     assert abs(float(got[-1, 2]) - float(plain[-1, 2])) > 1e-4  # the effect changes the prediction
+
+
+def test_a_model_with_the_exact_limit_surface_carries_the_objects_support():
+    built = model.make_model("rect1", effects=("limit_surface",), params={"limit_surface": {"rim": 1.0}})
+    assert built.support is not None and model.make_model("rect1").support is None
+    path = jnp.stack([jnp.linspace(-0.06, -0.02, 11), jnp.full(11, 0.01)], axis=-1)
+    got = model.predict(built, jnp.zeros(3), path).poses
+    expected = rollout.rollout(outline_jax.outline("rect1"), jnp.zeros(3), path, built.l, built.mu, built.params,
+                               effects=("limit_surface",), support=rollout.object_support("rect1")).poses
+    np.testing.assert_allclose(got, expected, atol=1e-8)
+    plain = model.predict(model.make_model("rect1"), jnp.zeros(3), path).poses
+    assert abs(float(got[-1, 2]) - float(plain[-1, 2])) > 1e-4

@@ -43,7 +43,8 @@ def test_smoke_run_writes_results_and_resumes(tmp_path):
 def test_model_names_and_effect_parameters():
     assert push_to_goal.model_effects("lynch") == ()
     assert push_to_goal.model_effects("lynch+pusher_friction+friction_ratio") == ("pusher_friction", "friction_ratio")
-    for bad in ("newton", "lynch+", "lynch+wind", "lynch+limit_surface+friction_ratio", "lynch+limit_surface"):
+    assert push_to_goal.model_effects("lynch+limit_surface+table_tilt") == ("limit_surface", "table_tilt")
+    for bad in ("newton", "lynch+", "lynch+wind", "lynch+limit_surface+friction_ratio"):
         with pytest.raises(ValueError):
             push_to_goal.model_effects(bad)
     params = push_to_goal.parse_effect_params("friction_ratio.log_scale=0.3; cof_offset.offset=0.01,-0.002")

@@ -121,3 +121,19 @@ def test_make_system_names_bad_arguments():
         models.make_system("rect1", measurement_std=(0.0, 1e-3, 1e-3))
     with pytest.raises(ValueError, match="mu, l"):
         models.make_system("rect1", mu=-1.0)
+
+
+def test_the_ekf_tracks_with_the_exact_limit_surface_and_identifies_mu_where_it_slips():
+    system = models.make_system("rect1", mu=MU_NOMINAL, process_std=(1e-4, 1e-4, 1e-3, 1e-3, 1e-3),
+                                measurement_std=MEASUREMENT_STD, effects=("limit_surface",),
+                                params={"limit_surface": {"rim": 1.0, "feet": 0.0}})
+    assert system.support is not None
+    paths = np.stack([_path(0, 0.3, 35.0), _path(1, 0.6, -40.0)])
+    true_state = np.stack([np.zeros(2), np.zeros(2), np.zeros(2), TRUE_LOG_MU[SLIPPING], np.zeros(2)], axis=-1)
+    truth = np.asarray(metrics.simulate(system, true_state, paths))
+    measurements = metrics.measure(truth, MEASUREMENT_STD, drop_rate=0.1, seed=1)
+    mean = np.concatenate([measurements[:, 0], np.zeros((2, 2))], axis=-1)
+    track = ekf.filter_pushes(system, mean, np.broadcast_to(np.diag(PRIOR_STD ** 2), (2, 5, 5)), paths, measurements)
+    position, _ = metrics.rmse(np.asarray(track.mean[..., :3]), truth)
+    assert position < 0.7 * metrics.rmse(measurements, truth)[0]
+    assert np.all(np.abs(np.asarray(track.mean[:, -1, 3]) - TRUE_LOG_MU[SLIPPING]) < 0.35), track.mean[:, -1, 3]

@@ -11,9 +11,9 @@ import pytest
 from pushjax import planar
 from pushjax.geometry import contact as contact_lib
 from pushjax.geometry import outline_jax
-from pushjax.geometry.objects import PUSHER_RADIUS, get_object, limit_surface_ratio
+from pushjax.geometry.objects import PUSHER_RADIUS, get_object, limit_surface_ratio, support
 from pushjax.physics import effects, rollout
-from tests.physics import numpy_lynch
+from tests.physics import numpy_limit_surface, numpy_lynch
 
 STEPS = 30
 
@@ -244,3 +244,56 @@ def test_every_effect_composes_in_a_rollout_and_no_effect_values_change_nothing(
     plain = rollout.rollout(shape, jnp.zeros(3), path, 0.04, 0.3).poses[-1]
     assert np.abs(np.asarray(plain)).max() > 1e-3
     np.testing.assert_allclose(final, plain, atol=1e-6)
+
+
+def _numpy_exact_rollout(obj, pose, pusher_path, mu):
+    """The rollout with the exact limit surface of the object's uniform support, written with the NumPy contact
+    annotation and the NumPy maximal-dissipation reference."""
+    points, weights, _, patch_radius = support(obj)
+    pose = np.asarray(pose, np.float64).copy()
+    poses = [pose.copy()]
+    for start, end in itertools.pairwise(pusher_path):
+        state = contact_lib.annotate(obj, pose, start, end - start)
+        world = points @ planar.rotation_matrix(pose[2]).T
+        motion, _, _ = numpy_limit_surface.solve(state.contact_rel_com, state.normal, state.action_from_contact, mu,
+                                                 world, weights, patch_radius)
+        com_offset = planar.rotate(obj.centroid, pose[2])
+        com = pose[:2] + com_offset + motion[:2]
+        pose = np.array([*(com - planar.rotate(com_offset, motion[2])), pose[2] + motion[2]])
+        poses.append(pose.copy())
+    return np.stack(poses)
+
+
+@pytest.mark.parametrize("name, side, point, angle, mu", PUSHES[:2])
+def test_the_exact_limit_surface_rolls_out_as_a_numpy_maximal_dissipation_rollout(name, side, point, angle, mu):
+    obj = get_object(name)
+    path = _push(obj, side, point, angle, steps=12)
+    expected = _numpy_exact_rollout(obj, np.zeros(3), path, mu)
+    result = rollout.rollout(outline_jax.outline(obj), jnp.zeros(3), jnp.asarray(path, jnp.float32),
+                             limit_surface_ratio(obj), mu, effects=("limit_surface",),
+                             support=rollout.object_support(obj)).poses
+    assert np.abs(expected[-1] - expected[0]).max() > 1e-3
+    np.testing.assert_allclose(result, expected, atol=2e-5)
+    plain = rollout.rollout(outline_jax.outline(obj), jnp.zeros(3), jnp.asarray(path, jnp.float32),
+                            limit_surface_ratio(obj), mu).poses
+    assert np.abs(np.asarray(plain - result)[-1, 2]) > 1e-3  # the exact surface turns the object differently
+
+
+def test_the_exact_limit_surface_needs_the_support_and_its_gradients_match_finite_differences():
+    obj = get_object("tri2")
+    shape, path = outline_jax.outline(obj), jnp.asarray(_push(obj, 1, 0.3, -25.0, steps=10), jnp.float32)
+    with pytest.raises(ValueError, match="support"):
+        rollout.rollout(shape, jnp.zeros(3), path, 0.04, 0.3, effects=("limit_surface",))
+    support_ = rollout.object_support(obj)
+
+    def final_yaw(mu, rim):
+        params = {"limit_surface": {"rim": rim, "feet": jnp.float32(0.2)}}
+        return rollout.rollout(shape, jnp.zeros(3), path, 0.04, mu, params, effects=("limit_surface",),
+                               support=support_).poses[-1, 2]
+
+    gradient = jax.grad(final_yaw, argnums=(0, 1))(jnp.float32(0.15), jnp.float32(0.5))
+    for k, delta in enumerate(np.eye(2) * 2e-3):
+        args = np.array([0.15, 0.5])
+        difference = (final_yaw(*map(jnp.float32, args + delta)) - final_yaw(*map(jnp.float32, args - delta))) / 4e-3
+        np.testing.assert_allclose(gradient[k], difference, rtol=0.03, atol=2e-3)
+    assert abs(float(gradient[0])) > 1e-3 and abs(float(gradient[1])) > 1e-3
