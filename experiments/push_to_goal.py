@@ -1,7 +1,8 @@
 r"""Push objects to goal poses with model-predictive control, closed on the MuJoCo testbed.
 
   python -m experiments.push_to_goal --workdir=work/push_to_goal [--scale=smoke|cpu|full] [--objects=rect1,...]
-      [--goals=N] [--models=lynch,lynch+friction_ratio] [--effect_params='friction_ratio.log_scale=0.3']
+      [--goals=N] [--models=lynch,lynch+friction_ratio,loop] [--effect_params='friction_ratio.log_scale=0.3']
+      [--loop_model=W/model.json]
       [--planners=gradient,sampling] [--seed=0] [--surface=abs] [--testbed=realistic|ideal]
       [--testbed_overrides='drop_rate=0'] [--effects='table_tilt_deg=2'] [--max_time=60]
 
@@ -16,6 +17,7 @@ from absl import app, flags
 import experiments
 from pushjax.control import closed_loop, mpc, push_to_goal, report
 from pushjax.geometry.objects import OBJECT_NAMES
+from pushjax.physics import model_file
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
 
@@ -26,6 +28,8 @@ _OBJECTS = flags.DEFINE_list("objects", None, "Objects (default: the scale's).")
 _GOALS = flags.DEFINE_integer("goals", None, "Goals per object (default: the scale's).", lower_bound=1)
 _MODELS = flags.DEFINE_list("models", ["lynch"], "Models: lynch or lynch+<effect>+... (pushjax.physics.effects).")
 _EFFECT_PARAMS = flags.DEFINE_string("effect_params", "", "The models' effect parameters, effect.parameter=value;...")
+_LOOP_MODEL = flags.DEFINE_string("loop_model", None,
+                                  "Pushing model file of the model 'loop' (experiments.close_loop's model.json).")
 _PLANNERS = flags.DEFINE_list("planners", None, f"Planners from {','.join(mpc.PLANNERS)} (default: the scale's).")
 _SEED = flags.DEFINE_integer("seed", 0, "Seed of the goals, the testbed's draws and the planners.", lower_bound=0)
 _SURFACE = flags.DEFINE_enum("surface", "abs", list(SURFACE_NAMES), "Surface the objects are pushed on.")
@@ -71,6 +75,10 @@ def _parse_models(names):
 
 
 flags.register_validator("models", _parsed_by(_parse_models))
+flags.register_validator("loop_model", _parsed_by(lambda path: path is None or model_file.read(path)))
+flags.register_multi_flags_validator(
+    ["models", "loop_model"], lambda values: (push_to_goal.LOOP_MODEL in values["models"]) == bool(values["loop_model"]),
+    f"--loop_model: expected exactly when --models has '{push_to_goal.LOOP_MODEL}'")
 flags.register_validator("effect_params", _parsed_by(push_to_goal.parse_effect_params))
 flags.register_validator("effects", _parsed_by(Effects.parse))
 
@@ -84,7 +92,7 @@ def main(argv):
                                   testbed=testbed, effects=Effects.parse(_EFFECTS.value))
     results = push_to_goal.run(_WORKDIR.value, _OBJECTS.value or scale["objects"], _GOALS.value or scale["goals"],
                                _MODELS.value, _PLANNERS.value or scale["planners"], _SEED.value, loop,
-                               _EFFECT_PARAMS.value, scale["controller"])
+                               _EFFECT_PARAMS.value, scale["controller"], _LOOP_MODEL.value)
     results["settings"]["scale"] = _SCALE.value
     paths = report.write(results, _WORKDIR.value)
     print(paths[1].read_text())

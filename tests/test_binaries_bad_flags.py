@@ -239,6 +239,9 @@ CASES = [
                            ("max_time", ("0", "nan")))
       for value in values],
     ("push_to_goal", ["--workdir={tmp}/goals", "extra"], "unexpected arguments"),
+    ("push_to_goal", ["--workdir={tmp}/goals", "--models=lynch,loop"], "--loop_model"),
+    ("push_to_goal", ["--workdir={tmp}/goals", "--loop_model={file}"], "--loop_model"),
+    ("push_to_goal", ["--workdir={tmp}/goals", "--models=loop", "--loop_model={tmp}/missing.json"], "--loop_model"),
     # demo
     *[("demo", [f"--{flag}={value}"], f"--{flag}")
       for flag, values in (("mu", ("-1", "nan", "inf")), ("angle_deg", ("90", "-120", "nan")),

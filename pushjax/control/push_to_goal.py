@@ -3,8 +3,10 @@ object to its goals on the testbed, closed loop.
 
 Models are named ``lynch`` (plain Lynch) or ``lynch+<effect>+...`` (Lynch with effects of
 :data:`pushjax.physics.effects.EFFECTS`), their parameters set by ``effect.parameter=value`` items
-(:func:`parse_effect_params`; unset parameters keep their "no effect" values). Each model plans with the testbed's
-nominal pusher friction and the uniform-pressure limit-surface ratio. Episodes are appended to
+(:func:`parse_effect_params`; unset parameters keep their "no effect" values), planning with the testbed's nominal
+pusher friction; or ``loop``: the model in a pushing model file (:mod:`pushjax.physics.model_file`, e.g. the
+``model.json`` that ``experiments.close_loop`` selected), with its effects, parameters and pusher friction. Every
+model plans with the uniform-pressure limit-surface ratio. Episodes are appended to
 ``episodes.jsonl`` in the work folder as they finish, keyed by the run's settings, so an interrupted run resumes
 where it stopped; :mod:`pushjax.control.report` turns the rows into ``results.json``, a table and a figure.
 """
@@ -24,6 +26,7 @@ from pushjax.control import closed_loop, goals, gradient, mpc, report
 from pushjax.control.model import make_model
 from pushjax.geometry.objects import OBJECT_NAMES
 from pushjax.physics import effects as effects_lib
+from pushjax.physics import model_file
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
 
 __all__ = ["SCALES", "model_effects", "parse_effect_params", "run"]
@@ -43,15 +46,22 @@ TRAJECTORY_STRIDE = 5
 """Control periods between the poses kept for the figure."""
 
 
+LOOP_MODEL = "loop"
+"""The name of the model read from a pushing model file."""
+
+
 def model_effects(name: str) -> tuple[str, ...]:
-    """The effects of the model called `name` (``lynch`` or ``lynch+effect+...``).
+    """The effects of the model called `name` (``lynch`` or ``lynch+effect+...``; () for ``loop``, whose effects
+    are in its file).
 
     Raises:
       ValueError: not of that form, an unknown effect or effects that do not compose; one line.
     """
+    if name == LOOP_MODEL:
+        return ()
     parts = name.split("+")
     if parts[0] != "lynch" or any(not part for part in parts):
-        raise ValueError(f"model {name!r}: expected 'lynch' or 'lynch+<effect>+...'")
+        raise ValueError(f"model {name!r}: expected 'lynch', 'lynch+<effect>+...' or '{LOOP_MODEL}'")
     effects = tuple(parts[1:])
     effects_lib.init_params(effects)
     return effects
@@ -92,7 +102,7 @@ def _fingerprint(settings: dict) -> str:
 
 def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, models: Sequence[str],
         planners: Sequence[str], seed: int, loop: closed_loop.LoopConfig, effect_params: str = "",
-        controller: mpc.ControllerConfig = mpc.ControllerConfig()) -> dict:
+        controller: mpc.ControllerConfig = mpc.ControllerConfig(), loop_model: str | Path | None = None) -> dict:
     """Runs every model and planner on every goal (resuming from ``workdir/episodes.jsonl``); returns the
     results of :func:`pushjax.control.report.summarise`.
 
@@ -106,12 +116,26 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
       loop: the :class:`~pushjax.control.closed_loop.LoopConfig` (testbed, world, surface, limits).
       effect_params: the models' effect parameters (:func:`parse_effect_params`).
       controller: the controller's settings (``planner`` replaced by each of `planners`).
+      loop_model: the pushing model file of the ``loop`` model (needed when `models` has it).
+
+    Raises:
+      ValueError: ``loop`` among `models` without `loop_model`, or a bad model file; one line.
     """
     params = parse_effect_params(effect_params)
-    model_specs = {name: model_effects(name) for name in models}
+    specs = {}
+    for name in models:
+        effects = model_effects(name)
+        specs[name] = model_file.AugmentedModel.create(
+            effects, {effect: values for effect, values in params.items() if effect in effects}, PUSHER_OBJECT_FRICTION)
+    if LOOP_MODEL in models:
+        if loop_model is None:
+            raise ValueError(f"loop_model: the model {LOOP_MODEL!r} needs a pushing model file")
+        specs[LOOP_MODEL] = model_file.read(loop_model)
     tasks = goals.draw_goals(objects, goals_per_object, seed)
     settings = {"seed": seed, "loop": dataclasses.asdict(loop), "effect_params": effect_params,
                 "controller": repr(controller)}
+    if LOOP_MODEL in models:
+        settings["loop_model"] = specs[LOOP_MODEL].as_dict()
     fingerprint = _fingerprint(settings)
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
@@ -130,9 +154,8 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
             if key in done:
                 rows.append(done[key])
                 continue
-            effects = model_specs[name]
-            model = make_model(task.obj, mu=PUSHER_OBJECT_FRICTION, effects=effects,
-                               params={effect: values for effect, values in params.items() if effect in effects})
+            spec = specs[name]
+            model = make_model(task.obj, mu=spec.mu, effects=spec.effects, params=spec.params)
             config = dataclasses.replace(controller, planner=planner)
             result = closed_loop.run_episode(model, config, task.obj, task.start, task.goal, seed=seed,
                                              index=task.index, loop=loop)

@@ -27,6 +27,7 @@ from pushjax.loop import shape as shape_lib
 from pushjax.loop import splits as splits_lib
 from pushjax.loop.windows import NOMINAL_PUSHER_FRICTION, Examples, build_examples
 from pushjax.mit.files import iter_pushes
+from pushjax.physics import model_file
 from pushjax.physics.effects import EFFECT_NAMES
 
 
@@ -298,7 +299,10 @@ def close_loop(
             fallback_beyond_noise=decision.fallback_helps,
             selected_params=model.physical if model is not None else {},
         )
-        result = report_lib.LoopResult(report=report, details=details)
+        selected_model = model_file.AugmentedModel.create(
+            model.effects if model is not None else (), model.params if model is not None else {},
+            float(pool.inputs.mu[0]))
+        result = report_lib.LoopResult(report=report, details=details, model=selected_model)
         figures = workdir / report_lib.FIGURE_DIR
         figures.mkdir(parents=True, exist_ok=True)
         report_lib.write(workdir, result)

@@ -18,6 +18,7 @@ from pushjax.loop import shape as shape_lib
 from pushjax.loop import metrics
 from pushjax.loop import select as select_lib
 from pushjax.loop.windows import CATEGORICAL, VARIABLES, Examples
+from pushjax.physics import model_file
 
 FIGURE_DIR = "figures"
 
@@ -255,10 +256,12 @@ class LoopDetails:
 
 @dataclasses.dataclass(frozen=True)
 class LoopResult:
-    """What :func:`pushjax.loop.pipeline.close_loop` found and how it decided."""
+    """What :func:`pushjax.loop.pipeline.close_loop` found and how it decided, and the selected model refitted on
+    the pool with the pusher friction the loop used (``model.json``, :mod:`pushjax.physics.model_file`)."""
 
     report: LoopReport
     details: LoopDetails
+    model: model_file.AugmentedModel
 
 
 def _strengths(dependences: list[diagnose_lib.Dependence]) -> list[dict]:
@@ -266,9 +269,10 @@ def _strengths(dependences: list[diagnose_lib.Dependence]) -> list[dict]:
 
 
 def write(workdir: Path, result: LoopResult) -> None:
-    """Writes ``report.json``, ``details.json`` and ``report.md`` to ``workdir`` (which exists)."""
+    """Writes ``report.json``, ``details.json``, ``model.json`` and ``report.md`` to ``workdir`` (which exists)."""
     write_json(workdir / "report.json", result.report.as_dict())
     write_json(workdir / "details.json", result.details.as_dict())
+    model_file.write(workdir / "model.json", result.model)
     (workdir / "report.md").write_text(markdown(result))
 
 

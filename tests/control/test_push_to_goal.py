@@ -55,3 +55,13 @@ def test_model_names_and_effect_parameters():
                          ("friction_ratio.log_scale=x", "numbers")):
         with pytest.raises(ValueError, match=message):
             push_to_goal.parse_effect_params(bad)
+
+
+def test_the_loop_model_needs_its_file(tmp_path):
+    with pytest.raises(ValueError, match="loop_model"):
+        push_to_goal.run(tmp_path, ("rect1",), 1, ["lynch", "loop"], ["gradient"], 0, closed_loop.LoopConfig())
+    (tmp_path / "model.json").write_text('{"effects": ["wind"], "params": {}, "pusher_friction": 0.3}')
+    with pytest.raises(ValueError, match="model.json: effects: unknown 'wind'"):
+        push_to_goal.run(tmp_path, ("rect1",), 1, ["loop"], ["gradient"], 0, closed_loop.LoopConfig(),
+                         loop_model=tmp_path / "model.json")
+    assert not (tmp_path / "episodes.jsonl").exists()

@@ -21,6 +21,7 @@ from pushjax.loop.hierarchy import GroupValues
 from pushjax.loop.metrics import NoiseFloor
 from pushjax.loop.shape import LimitSurfaceShape
 from pushjax.loop.select import Heterogeneity, MechanismCheck, Round
+from pushjax.physics import model_file
 
 EXPECTED = Path(__file__).parent / "report_small"
 
@@ -97,7 +98,8 @@ def small_result(measured_friction: bool) -> report_lib.LoopResult:
         skipped={"unknown object": ["a.h5", "b.h5"]}, diagnosis_before=before, diagnosis_after=after,
         select_noise_floor=floor, rounds=rounds, fallback_gain=0.125, fallback_p_value=0.0625,
         fallback_beyond_noise=False, selected_params={"cof_offset": offset})
-    return report_lib.LoopResult(report=report, details=details)
+    model = model_file.AugmentedModel.create(("cof_offset",), {"cof_offset": {"offset": [0.004, -0.001]}}, 0.25)
+    return report_lib.LoopResult(report=report, details=details, model=model)
 
 
 def test_report_files_keep_every_key_and_byte(tmp_path):
@@ -109,6 +111,7 @@ def test_report_files_keep_every_key_and_byte(tmp_path):
             expected = EXPECTED / f"{'measured' if measured_friction else 'nominal'}_{name}"
             assert (workdir / name).read_text() == expected.read_text(), name
         assert json.loads((workdir / "report.json").read_text()) == small_result(measured_friction).report.as_dict()
+        assert model_file.read(workdir / "model.json").as_dict() == small_result(measured_friction).model.as_dict()
 
 
 def test_explained_is_the_test_error_within_the_noise_floor_interval():
