@@ -16,7 +16,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["Goal", "MAX_ROTATION_DEG", "SUCCESS_POSITION", "SUCCESS_YAW_DEG", "TRANSLATION_RANGE", "draw_goals",
+__all__ = ["COMPARISON_STANDARD_ERRORS", "Goal", "MAX_ROTATION_DEG", "SUCCESS_POSITION", "SUCCESS_YAW_DEG", "TRANSLATION_RANGE", "draw_goals",
            "succeeded", "wilson_interval"]
 
 SUCCESS_POSITION = 0.005
@@ -27,6 +27,11 @@ TRANSLATION_RANGE = (0.05, 0.20)
 """Range of the goals' translations, m."""
 MAX_ROTATION_DEG = 90.0
 """Largest goal rotation, degrees (either sense)."""
+COMPARISON_STANDARD_ERRORS = 2.0
+"""When one model pushes better than another (fixed before any comparison was run): over the goals both were given
+(same object, goal and planner; the goals are the independent unit), the mean of the paired difference of the time
+to success, a failed goal counting as the episode's time limit, is below zero by more than this many standard errors
+of that mean. Above zero by as much: worse; in between: not decided with that many goals."""
 
 
 @dataclasses.dataclass(frozen=True)

@@ -17,7 +17,7 @@ from pushjax import outputs, planar
 from pushjax.control import goals
 from pushjax.geometry.objects import PUSHER_RADIUS, get_object
 
-__all__ = ["episode_row", "figure", "summarise", "table", "write"]
+__all__ = ["compare", "episode_row", "figure", "summarise", "table", "write"]
 
 
 def episode_row(task: goals.Goal, result, stride: int) -> dict:
@@ -50,9 +50,43 @@ def _summary(rows: Sequence[dict]) -> dict:
     }
 
 
+def compare(rows: Sequence[dict], baseline: str, model: str, max_time: float) -> dict:
+    """`model` against `baseline` on the goals both were given (paired by planner, object and goal), decided by
+    :data:`pushjax.control.goals.COMPARISON_STANDARD_ERRORS`.
+
+    Returns:
+      ``{"model", "baseline", "goals", "time_to_success_difference_s": {"mean", "standard_error"},
+      "position_error_difference_mm": {"mean", "standard_error"}, "only_model_succeeded",
+      "only_baseline_succeeded", "verdict"}``; differences are `model` minus `baseline`, a failed goal's time to
+      success is `max_time` (s), and the verdict is "better", "worse" or "not decided".
+    """
+    def by_goal(name):
+        return {(row["planner"], row["object"], row["index"]): row for row in rows if row["model"] == name}
+
+    ours, theirs = by_goal(model), by_goal(baseline)
+    keys = sorted(set(ours) & set(theirs))
+
+    def time_to_success(row):
+        return row["time_s"] if row["success"] else max_time
+
+    def paired(value):
+        difference = np.array([value(ours[key]) - value(theirs[key]) for key in keys])
+        error = float(np.std(difference, ddof=1) / math.sqrt(len(keys))) if len(keys) > 1 else math.inf
+        return {"mean": float(np.mean(difference)) if keys else math.nan, "standard_error": error}
+
+    time = paired(time_to_success)
+    margin = goals.COMPARISON_STANDARD_ERRORS * time["standard_error"]
+    verdict = "better" if time["mean"] < -margin else "worse" if time["mean"] > margin else "not decided"
+    return {"model": model, "baseline": baseline, "goals": len(keys), "time_to_success_difference_s": time,
+            "position_error_difference_mm": paired(lambda row: row["position_error_mm"]),
+            "only_model_succeeded": sum(ours[key]["success"] and not theirs[key]["success"] for key in keys),
+            "only_baseline_succeeded": sum(theirs[key]["success"] and not ours[key]["success"] for key in keys),
+            "verdict": verdict}
+
+
 def summarise(rows: Sequence[dict], settings: dict) -> dict:
     """``{"criterion", "settings", "summary": {model/planner: ...}, "per_object": {model/planner: {object: ...}},
-    "episodes": rows}``."""
+    "comparisons": [every other model against the first, :func:`compare`], "episodes": rows}``."""
     groups: dict[str, list[dict]] = {}
     for row in rows:
         groups.setdefault(f"{row['model']}/{row['planner']}", []).append(row)
@@ -60,9 +94,12 @@ def summarise(rows: Sequence[dict], settings: dict) -> dict:
     for name, members in groups.items():
         objects = sorted({row["object"] for row in members})
         per_object[name] = {obj: _summary([row for row in members if row["object"] == obj]) for obj in objects}
-    return {"criterion": {"position_mm": 1e3 * goals.SUCCESS_POSITION, "yaw_deg": goals.SUCCESS_YAW_DEG},
+    models = list(dict.fromkeys(row["model"] for row in rows))
+    comparisons = [compare(rows, models[0], model, settings["loop"]["max_time"]) for model in models[1:]]
+    return {"criterion": {"position_mm": 1e3 * goals.SUCCESS_POSITION, "yaw_deg": goals.SUCCESS_YAW_DEG,
+                          "comparison_standard_errors": goals.COMPARISON_STANDARD_ERRORS},
             "settings": settings, "summary": {name: _summary(members) for name, members in groups.items()},
-            "per_object": per_object, "episodes": list(rows)}
+            "per_object": per_object, "comparisons": comparisons, "episodes": list(rows)}
 
 
 def _line(label: str, entry: dict) -> str:
@@ -81,6 +118,17 @@ def table(results: dict) -> str:
     lines = [f"Success: final position error < {criterion['position_mm']:g} mm and orientation error < "
              f"{criterion['yaw_deg']:g} deg.", "", header.format("model / planner")]
     lines += [_line(name, entry) for name, entry in results["summary"].items()]
+    if results.get("comparisons"):
+        lines += ["", (f"Comparisons (paired over goals; better: the mean difference of the time to success, a failure "
+                       f"counting as the time limit, below zero by more than {criterion['comparison_standard_errors']:g} "
+                       "standard errors):"), "",
+                  "| model − baseline | goals | time to success (s) | final position error (mm) | only model succeeded "
+                  "| only baseline succeeded | verdict |", "|---|---:|---:|---:|---:|---:|---|"]
+        for entry in results["comparisons"]:
+            time, position = entry["time_to_success_difference_s"], entry["position_error_difference_mm"]
+            lines.append(f"| {entry['model']} − {entry['baseline']} | {entry['goals']} | {time['mean']:+.1f} ± "
+                         f"{time['standard_error']:.1f} | {position['mean']:+.1f} ± {position['standard_error']:.1f} | "
+                         f"{entry['only_model_succeeded']} | {entry['only_baseline_succeeded']} | {entry['verdict']} |")
     lines += ["", header.format("model / planner, object")]
     lines += [_line(f"{name}, {obj}", entry) for name, objects in results["per_object"].items()
               for obj, entry in objects.items()]

@@ -19,15 +19,34 @@ def _row(model, obj, index, position_mm, yaw_deg):
 def test_summaries_tables_and_figure(tmp_path):
     rows = [_row("lynch", "rect1", 0, 1.0, 0.5), _row("lynch", "rect1", 1, 7.0, 0.5),
             _row("lynch", "tri2", 0, 2.0, -6.0), _row("lynch+friction_ratio", "rect1", 0, 1.0, 1.0)]
-    results = report.summarise(rows, {"seed": 0})
+    results = report.summarise(rows, {"seed": 0, "loop": {"max_time": 60.0}})
     lynch = results["summary"]["lynch/gradient"]
     assert (lynch["goals"], lynch["successes"]) == (3, 1)
     np.testing.assert_allclose(lynch["wilson_95"], goals.wilson_interval(1, 3))
     assert lynch["position_error_mm_median"] == 2.0 and lynch["yaw_error_deg_median"] == 0.5
     assert results["per_object"]["lynch/gradient"]["rect1"]["successes"] == 1
-    assert results["criterion"] == {"position_mm": 5.0, "yaw_deg": 5.0}
+    assert results["criterion"] == {"position_mm": 5.0, "yaw_deg": 5.0, "comparison_standard_errors": 2.0}
+    assert [entry["goals"] for entry in results["comparisons"]] == [1]
     paths = report.write(results, tmp_path)
     assert json.loads(paths[0].read_text())["summary"]["lynch/gradient"]["goals"] == 3
     text = paths[1].read_text()
     assert "| lynch/gradient | 1/3 | 33 % [6, 79] |" in text and "| lynch/gradient, tri2 | 0/1 |" in text
     assert paths[2].stat().st_size > 5000
+
+
+def test_a_model_that_reaches_the_same_goals_sooner_is_better_and_a_failure_counts_as_the_time_limit():
+    rows = []
+    for index in range(6):
+        rows.append(_row("lynch", "rect1", index, 1.0, 0.5) | {"time_s": 30.0 + index})
+        rows.append(_row("loop", "rect1", index, 1.0, 0.5) | {"time_s": 20.0 + 2 * index})
+    better = report.compare(rows, "lynch", "loop", max_time=60.0)
+    assert better["goals"] == 6 and better["verdict"] == "better"
+    np.testing.assert_allclose(better["time_to_success_difference_s"]["mean"], -7.5)
+    assert report.compare(rows, "loop", "lynch", max_time=60.0)["verdict"] == "worse"
+    # One failure of the faster model (at 25 s, 7 mm off) costs it the time limit: 60 - 35 = +25 s on that goal.
+    rows[-1] = rows[-1] | {"success": False, "position_error_mm": 7.0, "time_s": 25.0}
+    mixed = report.compare(rows, "lynch", "loop", max_time=60.0)
+    np.testing.assert_allclose(mixed["time_to_success_difference_s"]["mean"], (-10 - 9 - 8 - 7 - 6 + 25) / 6)
+    assert mixed["verdict"] == "not decided" and mixed["only_baseline_succeeded"] == 1
+    text = report.table(report.summarise(rows, {"loop": {"max_time": 60.0}}))
+    assert "| loop − lynch | 6 |" in text and "not decided" in text
