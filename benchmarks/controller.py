@@ -7,6 +7,10 @@ sampling 4 × 64 cross-entropy samples), from rect1-like states: the object at t
 (best) of ``--repeats`` calls.
 
     python benchmarks/controller.py [--objects=rect1,ellip2,butter] [--planners=gradient,sampling] [--repeats=20]
+        [--effects=limit_surface,table_tilt]
+
+``--effects`` plans with Lynch's model and those effects at their "no effect" values (``limit_surface``: the exact
+limit surface of the uniform support, a Newton solve per step instead of Lynch's closed form).
 """
 
 import platform
@@ -22,16 +26,17 @@ from timing import time_calls
 _OBJECTS = flags.DEFINE_list("objects", ["rect1", "ellip2", "butter"], "Objects to measure.")
 _PLANNERS = flags.DEFINE_list("planners", list(mpc.PLANNERS), "Planners to measure.")
 _REPEATS = flags.DEFINE_integer("repeats", 20, "Timed calls per measurement.")
+_EFFECTS = flags.DEFINE_list("effects", [], "Effects composed with Lynch's model (pushjax.physics.effects).")
 
 
 def main(argv):
     del argv
     print(f"{platform.processor() or platform.machine()}, {jax.devices()[0].platform}, jax {jax.__version__}; "
-          f"default ControllerConfig, float32, median (best) of {_REPEATS.value}\n")
+          f"default ControllerConfig, float32, effects {_EFFECTS.value or 'none'}, median (best) of {_REPEATS.value}\n")
     print("| object | planner | first call (s) | time per plan (ms) | plans/s |")
     print("|---|---|---:|---:|---:|")
     for name in _OBJECTS.value:
-        push_model = model.make_model(name)
+        push_model = model.make_model(name, effects=_EFFECTS.value)
         left = float(get_object(name).outline[:, 0].min())
         pusher = jnp.array([left - PUSHER_RADIUS - 1e-3, 0.0])
         goal = jnp.array([0.1, 0.0, 0.785])
