@@ -5,7 +5,9 @@ r"""Close the loop on measured pushes: residual → the missing effect → refit
 
 DIR holds pushes in the raw MIT layout (``<surface>/<object>/motion_surface=...h5``: real MIT files or the
 testbed's, ``python -m experiments.record_pushes``); only the streams and the file-name fields are used.
-Writes ``OUT/report.json``, ``OUT/details.json``, ``OUT/report.md`` and ``OUT/figures/*.png``; see
+Writes ``OUT/report.json``, ``OUT/details.json``, ``OUT/model.json`` (the selected model, which
+``experiments.push_to_goal --models=loop --loop_model=OUT/model.json`` plans with), ``OUT/report.md`` and
+``OUT/figures/*.png``; see
 :mod:`pushjax.loop`. Effects are chosen on fit and select push sequences and measured on a test split of
 ``--heldout_fraction`` of them. With too few push sequences to select on it stops with one line naming how
 many it found and how many it needs.
@@ -68,7 +70,7 @@ def main(argv):
     summary = {key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "noise_floor", "explained",
                                             "fallback", "remaining")}
     print(json.dumps(summary, indent=2))
-    print(f"wrote report.json, details.json, report.md and figures/ to {_WORKDIR.value}")
+    print(f"wrote report.json, details.json, model.json, report.md and figures/ to {_WORKDIR.value}")
 
 
 if __name__ == "__main__":

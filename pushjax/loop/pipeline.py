@@ -184,7 +184,8 @@ def close_loop(
     seed: int = 0,
     progress: bool = True,
 ) -> report_lib.LoopResult:
-    """Runs the loop and writes ``report.json``, ``details.json``, ``report.md`` and figures to ``workdir``.
+    """Runs the loop and writes ``report.json``, ``details.json``, ``model.json`` (the selected model,
+    :mod:`pushjax.physics.model_file`), ``report.md`` and figures to ``workdir``.
 
     Args:
       data_dir: root of pushes in the raw MIT layout (``<surface>/<object>/motion_surface=...h5``).

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import jax
 
+from pushjax.physics import model_file
+
 REPO = Path(__file__).resolve().parents[2]
 
 
@@ -39,6 +41,7 @@ def test_writes_the_report(record, tmp_path):
     assert sorted(entry["effect"] for entry in report["ranking"]) == ["limit_surface", "table_tilt"]
     assert json.loads(result.stdout[:result.stdout.rindex("}") + 1])["selected"] == report["selected"]
     assert (tmp_path / "out" / "report.md").is_file() and (tmp_path / "out" / "details.json").is_file()
+    assert model_file.read(tmp_path / "out" / "model.json").effects == tuple(report["selected"])
 
 
 def test_missing_or_empty_data_dir_names_the_flag(tmp_path):
