@@ -222,8 +222,10 @@ CASES = [
     *[("track", ["--workdir={tmp}/track", f"--{flag}={value}"], f"--{flag}")
       for flag, values in (("scale", ("paper", "huge")), ("filters", ("kalman", "ekf,ekf", "")),
                            ("seed", ("-1",)), ("rate_hz", ("0", "7", "nan", "500")),
+                           ("learn_steps", ("0", "-3", "1.5")),
                            ("testbed", ("perfect",)), ("testbed_overrides", ("drop_rate=2", "wind=1")))
       for value in values],
+    ("track", ["--workdir={tmp}/track", "--learn_steps=5", "--filters=ekf,ukf"], "--learn_steps"),
     ("track", ["--workdir={tmp}/track", "extra"], "unexpected arguments"),
     # push_to_goal
     ("push_to_goal", [], "--workdir"),

@@ -2,8 +2,9 @@
 ratio) from motion-capture poses, with the JAX rollout step as the process model: an extended (``ekf``) and an
 unscented (``ukf``) Kalman filter and a particle filter (``particle``), sharing ``models``, and a
 constant-velocity baseline (``constant_velocity``); ``metrics`` scores them (pose RMSE, NEES and its chi-square
-band). ``tracking`` (not imported here: it needs the MuJoCo testbed) runs them on simulated testbed pushes."""
+band); ``noise`` learns the EKF's noise magnitudes through the differentiable filter. ``tracking`` (not imported
+here: it needs the MuJoCo testbed) runs them on simulated testbed pushes."""
 
-from pushjax.filter import constant_velocity, ekf, metrics, models, particle, ukf
+from pushjax.filter import constant_velocity, ekf, metrics, models, noise, particle, ukf
 
-__all__ = ["constant_velocity", "ekf", "metrics", "models", "particle", "ukf"]
+__all__ = ["constant_velocity", "ekf", "metrics", "models", "noise", "particle", "ukf"]

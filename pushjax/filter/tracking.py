@@ -12,9 +12,11 @@ missing) and filtered together, ``jax.vmap`` over the pushes; the padding is lef
 
 The filters' state is the pose with the log scales of the nominal ``mu`` (the file's ``pushjax_pusher_friction``)
 and of the uniform-pressure ``l``; the testbed's uneven support pressure has no single true ``l``, so only its
-estimate is reported. Noise magnitudes are set by hand once (:data:`PROCESS_STD`, :data:`PRIOR_STD`, the
-realistic testbed's tracking noise as measurement noise); learning them through the differentiable filter is not
-done here.
+estimate is reported. Noise magnitudes are set by hand once (:data:`PROCESS_STD_PER_S`, :data:`LATENT_PRIOR_STD`,
+the realistic testbed's tracking noise as measurement noise); ``ekf_learned`` is the EKF with its process and
+measurement noise learned through the differentiable filter (:mod:`pushjax.filter.noise`), starting from the
+hand-set values, on training pushes simulated with another seed than the evaluated ones
+(:data:`TRAINING_SEED_OFFSET`).
 """
 
 from __future__ import annotations
@@ -30,26 +32,38 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from pushjax import outputs
-from pushjax.filter import constant_velocity, ekf, metrics, models, particle, ukf
+from pushjax.filter import constant_velocity, ekf, metrics, models, noise, particle, ukf
 from pushjax.sim import dataset
 from pushjax.sim.testbed import Testbed
 
-__all__ = ["FILTERS", "SCALES", "TrackedPush", "run", "simulate_pushes", "write"]
+__all__ = ["FILTERS", "SCALES", "TRAINING_SEED_OFFSET", "TrackedPush", "batches_by_object", "hand_set_noise",
+           "learn_noise", "run", "simulate_pushes", "write"]
 
-FILTERS = ("ekf", "ukf", "particle")
+FILTERS = ("ekf", "ukf", "particle", "ekf_learned")
 RECORDING_RATE_HZ = 250
 SCALES = {
-    "smoke": {"objects": ("rect1",), "pushes": 2, "particles": 64, "rate_hz": 5.0},
-    "cpu": {"objects": ("rect1", "tri2", "hex"), "pushes": 12, "particles": 256, "rate_hz": 10.0},
+    "smoke": {"objects": ("rect1",), "pushes": 2, "particles": 64, "rate_hz": 5.0, "learn_steps": 3},
+    "cpu": {"objects": ("rect1", "tri2", "hex"), "pushes": 12, "particles": 256, "rate_hz": 10.0,
+            "learn_steps": 200},
 }
-"""Objects, pushes per object (abs, 20 mm/s), particles and filter rate of each scale."""
+"""Objects, pushes per object (abs, 20 mm/s), particles, filter rate and Adam steps of ``ekf_learned``'s noise
+(:func:`pushjax.filter.noise.learn`) of each scale."""
+TRAINING_SEED_OFFSET = 1
+"""``ekf_learned`` learns its noise on pushes simulated with seed ``seed + TRAINING_SEED_OFFSET`` (other pushes,
+other draws of the testbed) and is evaluated, like every filter, on the pushes of ``seed``."""
 PROCESS_STD_PER_S = (3.75e-4, 3.75e-4, 6.25e-3, 3e-2, 3e-2)
 """Process noise of the pushing filters per sqrt(s) (x m, y m, yaw rad, log mu, log l), set by hand once on the
 ``cpu`` scale's seed-0 pushes (EKF, 10 Hz): of the pose scales 1, 1/2, 1/4, 1/8 and 1/16 of (3 mm, 3 mm, 0.05 rad)
 per sqrt(s), 1/8 gave the smallest pose RMSE with the NEES still in its 95 % band at 92 % of the steps (1/16: 84 %,
 mean NEES 5.8). Evaluate on other seeds."""
-PRIOR_STD = (1.0, 1.0, 1.0, 0.5, 0.3)
-"""Prior standard deviations: the pose in units of the measurement noise, log mu and log l (absolute)."""
+LATENT_PRIOR_STD = (0.5, 0.3)
+"""Prior standard deviations of log mu and log l; the pose's prior is the first measurement with the measurement
+noise (:func:`pushjax.filter.noise.initial_belief`)."""
+STANDSTILL_M = 1e-9
+"""A pusher step shorter than this (m) is the pusher standing still, made exactly zero for the filters: the testbed's
+pusher standing after its push moves by float noise (1e-25 to 1e-16 m a step), where the derivative of the rollout
+step's Jacobian with respect to the state (reverse mode, float32; :func:`pushjax.filter.noise.learn` needs it) is
+NaN, and finite at exactly zero. Far below a moving pusher's step (2 mm at 20 mm/s and 10 Hz)."""
 ACCELERATION_PSD = (1e-4, 1e-4, 1e-1)
 """Constant-velocity filter: white acceleration spectral densities ((m/s^2)^2 s, (m/s^2)^2 s, (rad/s^2)^2 s)."""
 
@@ -122,6 +136,16 @@ def _pad(arrays: list[np.ndarray], length: int, fill: str) -> np.ndarray:
     return np.stack(padded)
 
 
+def _held_when_still(path: np.ndarray) -> np.ndarray:
+    """[T + 1, 2] the pusher `path` with every step shorter than :data:`STANDSTILL_M` made exactly zero (the pusher
+    held where it was)."""
+    held = np.array(path, np.float64)
+    for k in range(1, len(held)):
+        if np.hypot(*(path[k] - held[k - 1])) < STANDSTILL_M:
+            held[k] = held[k - 1]
+    return held
+
+
 def _first_time_within(estimate: np.ndarray, truth: float, valid: int, dt: float, tolerance: float = 0.2):
     """Seconds after which the estimate [T] stays within `tolerance` (relative) of `truth`; None if it never does."""
     inside = np.abs(np.log(estimate[:valid] / truth)) < np.log1p(tolerance)
@@ -131,38 +155,91 @@ def _first_time_within(estimate: np.ndarray, truth: float, valid: int, dt: float
     return float((outside[-1] + 1) * dt) if len(outside) else 0.0
 
 
-def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, particles: int, seed: int,
-        measurement_std: Sequence[float]) -> dict:
-    """Runs the filters and the constant-velocity baseline on the pushes; returns the results (see :func:`write`)."""
-    dt = 1.0 / rate_hz
-    measurement_std = np.asarray(measurement_std, np.float64)
-    process_std = np.asarray(PROCESS_STD_PER_S) * math.sqrt(dt)
-    prior_std = np.concatenate([np.asarray(PRIOR_STD[:3]) * measurement_std, PRIOR_STD[3:]])
-    per_push, estimates = [], {name: [] for name in (*filters, "constant_velocity", "raw")}
-    truths, valid_masks = [], []
+def batches_by_object(
+        pushes: Sequence[TrackedPush]) -> list[tuple[models.System, list[TrackedPush], noise.PushBatch]]:
+    """The pushes grouped by object (sorted by name): each group's system (nominal mu and l, default noise), its
+    pushes and their :class:`~pushjax.filter.noise.PushBatch`, padded to the group's longest push; the pusher held
+    exactly where it stands still (:data:`STANDSTILL_M`)."""
+    groups = []
     for obj in sorted({push.obj for push in pushes}):
         group = [push for push in pushes if push.obj == obj]
-        length = max(len(push.pusher) for push in group)
-        valid = np.stack([np.arange(length) < len(push.pusher) for push in group])
-        paths = _pad([push.pusher for push in group], length, "edge")
-        measured = _pad([push.measurements for push in group], length, "nan")
-        truth = _pad([push.truth for push in group], length, "edge")
         nominal = np.array([push.mu_nominal for push in group])
         if np.ptp(nominal) > 0:
             raise ValueError(f"{obj}: the pushes declare different nominal mu {sorted(set(nominal))}")
-        system = models.make_system(obj, mu=float(nominal[0]), process_std=process_std,
-                                    measurement_std=measurement_std)
-        count = len(group)
-        mean = np.concatenate([measured[:, 0], np.zeros((count, 2))], axis=-1)
-        cov = np.broadcast_to(np.diag(prior_std ** 2), (count, 5, 5))
+        length = max(len(push.pusher) for push in group)
+        batch = noise.PushBatch(
+            pusher=_pad([_held_when_still(push.pusher) for push in group], length, "edge"),
+            measurements=_pad([push.measurements for push in group], length, "nan"),
+            truth=_pad([push.truth for push in group], length, "edge"),
+            valid=np.stack([np.arange(length) < len(push.pusher) for push in group]))
+        groups.append((models.make_system(obj, mu=float(nominal[0])), group, batch))
+    return groups
+
+
+def _process_std_per_step(rate_hz: float) -> np.ndarray:
+    """[5] :data:`PROCESS_STD_PER_S` per step of the filter at `rate_hz`."""
+    return np.asarray(PROCESS_STD_PER_S) * math.sqrt(1.0 / rate_hz)
+
+
+def hand_set_noise(rate_hz: float, measurement_std: Sequence[float]) -> noise.NoiseParams:
+    """The hand-set noise of the filters at `rate_hz`: :data:`PROCESS_STD_PER_S` per step and `measurement_std` [3]
+    (x m, y m, yaw rad)."""
+    return noise.make_params(_process_std_per_step(rate_hz), measurement_std)
+
+
+def learn_noise(pushes: Sequence[TrackedPush], rate_hz: float, measurement_std: Sequence[float],
+                steps: int) -> tuple[noise.NoiseParams, np.ndarray]:
+    """The EKF's noise learned on `pushes` (:func:`pushjax.filter.noise.learn`, `steps` Adam steps from
+    :func:`hand_set_noise`, the latents' prior :data:`LATENT_PRIOR_STD`); returns it and the loss curve
+    [steps + 1]."""
+    groups = batches_by_object(pushes)
+    return noise.learn(hand_set_noise(rate_hz, measurement_std), np.asarray(LATENT_PRIOR_STD),
+                       tuple(system for system, _, _ in groups), tuple(batch for _, _, batch in groups), steps)
+
+
+def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, particles: int, seed: int,
+        measurement_std: Sequence[float], training_pushes: Sequence[TrackedPush] = (), learn_steps: int = 0) -> dict:
+    """Runs the filters and the constant-velocity baseline on the pushes; returns the results (see :func:`write`).
+
+    Args:
+      pushes: the evaluated pushes.
+      filters: names from :data:`FILTERS`.
+      rate_hz: the filter rate, Hz (the pushes' clock).
+      particles: the particle filter's particle count.
+      seed: the particle filter's seed.
+      measurement_std: [3] the hand-set measurement noise (x m, y m, yaw rad).
+      training_pushes: the pushes ``ekf_learned`` learns its noise on (required with it): other pushes than
+        `pushes`, e.g. simulated with another seed (:data:`TRAINING_SEED_OFFSET`).
+      learn_steps: Adam steps of ``ekf_learned``'s noise (:func:`learn_noise`).
+    """
+    dt = 1.0 / rate_hz
+    measurement_std = np.asarray(measurement_std, np.float64)
+    hand_set = hand_set_noise(rate_hz, measurement_std)
+    noises = {name: hand_set for name in filters}
+    learning = None
+    if "ekf_learned" in filters:
+        if not training_pushes:
+            raise ValueError("ekf_learned: expected training pushes to learn the noise on, got none")
+        start = time.perf_counter()
+        noises["ekf_learned"], curve = learn_noise(training_pushes, rate_hz, measurement_std, learn_steps)
+        learning = {"steps": learn_steps, "training_pushes": len(training_pushes), "loss_curve": curve.tolist(),
+                    "seconds_with_compile": time.perf_counter() - start}
+    per_push, estimates = [], {name: [] for name in (*filters, "constant_velocity", "raw")}
+    truths, valid_masks = [], []
+    for system, group, batch in batches_by_object(pushes):
+        obj, count = group[0].obj, len(group)
+        paths, measured, truth, valid = batch.pusher, batch.measurements, batch.truth, batch.valid
         tracks, seconds = {}, {}
         for name in filters:
             start = time.perf_counter()
+            noisy = noise.with_noise(system, noises[name])
+            mean, cov = noise.initial_belief(noises[name], np.asarray(LATENT_PRIOR_STD), measured[:, 0])
             if name == "particle":
                 keys = jax.random.split(jax.random.key(seed), count)
-                track = particle.filter_pushes(system, keys, mean, cov, paths, measured, count=particles)
+                track = particle.filter_pushes(noisy, keys, mean, cov, paths, measured, count=particles)
             else:
-                track = {"ekf": ekf, "ukf": ukf}[name].filter_pushes(system, mean, cov, paths, measured)
+                track = {"ekf": ekf, "ukf": ukf, "ekf_learned": ekf}[name].filter_pushes(noisy, mean, cov, paths,
+                                                                                          measured)
             tracks[name] = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(track))
             seconds[name] = time.perf_counter() - start
         cv_mean = np.concatenate([measured[:, 0], np.zeros((count, 3))], axis=-1)
@@ -215,11 +292,19 @@ def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, parti
             entry["mu_final_abs_log_error"] = float(np.mean(errors))
             entry["mu_prior_abs_log_error"] = float(np.mean(prior_errors))
             entry["mu_final_std_log_over_prior"] = float(np.mean(
-                [row["filters"][name]["mu_std_log"][-1] / PRIOR_STD[3] for row in per_push]))
+                [row["filters"][name]["mu_std_log"][-1] / LATENT_PRIOR_STD[0] for row in per_push]))
         summary[name] = entry
-    return {"summary": summary, "pushes": per_push, "nees_band_95": [low, high], "rate_hz": rate_hz,
-            "filters": list(filters), "particles": particles, "measurement_std": measurement_std.tolist(),
-            "process_std_per_step": process_std.tolist(), "prior_std": prior_std.tolist()}
+    process_std = _process_std_per_step(rate_hz)
+    results = {"summary": summary, "pushes": per_push, "nees_band_95": [low, high], "rate_hz": rate_hz,
+               "filters": list(filters), "particles": particles, "measurement_std": measurement_std.tolist(),
+               "process_std_per_step": process_std.tolist(),
+               "prior_std": measurement_std.tolist() + list(LATENT_PRIOR_STD),
+               "noise": {"hand_set": {"process_std": process_std.tolist(),
+                                      "measurement_std": measurement_std.tolist()}}}
+    if learning is not None:
+        results["noise"]["learned"] = noise.standard_deviations(noises["ekf_learned"])
+        results["noise_learning"] = learning
+    return results
 
 
 def _table(results: dict) -> str:
@@ -233,6 +318,7 @@ def _table(results: dict) -> str:
         spread = f"{entry['mu_final_std_log_over_prior']:.2f}" if "mu_final_std_log_over_prior" in entry else ""
         lines.append(f"| {name} | {entry['position_rmse_mm']:.3f} | {entry['yaw_rmse_deg']:.3f} | {band} | {nees} "
                      f"| {mu} | {spread} |")
+    lines += _noise_table(results)
     header = " | ".join(f"{f}: final mu ± std(log), within 20 % after" for f in results["filters"])
     lines += ["", f"| push | mu true (nominal) | {header} |", "|---|---:|" + "---:|" * len(results["filters"])]
     for row in results["pushes"]:
@@ -245,6 +331,41 @@ def _table(results: dict) -> str:
         lines.append(f"| {row['object']} {row['name'].split('_a=')[1].removesuffix('.h5')} | {row['mu_true']:.3f} "
                      f"({row['mu_nominal']:.2f}) | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
+
+
+_NOISE_ROWS = (
+    ("process x per sqrt(s) (mm)", "process_std", 0, 1e3, True),
+    ("process y per sqrt(s) (mm)", "process_std", 1, 1e3, True),
+    ("process yaw per sqrt(s) (deg)", "process_std", 2, math.degrees(1.0), True),
+    ("process log mu per sqrt(s)", "process_std", 3, 1.0, True),
+    ("process log l per sqrt(s)", "process_std", 4, 1.0, True),
+    ("measurement x (mm)", "measurement_std", 0, 1e3, False),
+    ("measurement y (mm)", "measurement_std", 1, 1e3, False),
+    ("measurement yaw (deg)", "measurement_std", 2, math.degrees(1.0), False),
+)
+"""The rows of the noise table: label, key of :func:`pushjax.filter.noise.standard_deviations`, index, unit factor,
+per step converted to per sqrt(s)."""
+
+
+def _noise_table(results: dict) -> list[str]:
+    """The hand-set noise standard deviations beside the learned ones (if any) and the learning's loss curve."""
+    columns = [name for name in ("hand_set", "learned") if name in results["noise"]]
+    lines = ["", "| noise (standard deviation) | " + " | ".join(name.replace("_", "-") for name in columns) + " |",
+             "|---|" + "---:|" * len(columns)]
+    for label, key, index, unit, per_step in _NOISE_ROWS:
+        factor = unit * (math.sqrt(results["rate_hz"]) if per_step else 1.0)
+        cells = [f"{factor * results['noise'][name][key][index]:.4g}" for name in columns]
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    if "noise_learning" in results:
+        learning = results["noise_learning"]
+        curve = learning["loss_curve"]
+        marks = sorted({round(fraction * (len(curve) - 1)) for fraction in (0, 0.25, 0.5, 0.75, 1)})
+        seed = f" (seed {results['training_seed']})" if "training_seed" in results else ""
+        lines += ["", f"ekf_learned: noise learned on {learning['training_pushes']} training pushes{seed} in "
+                  f"{learning['steps']} Adam steps ({learning['seconds_with_compile']:.0f} s with compilation), the "
+                  f"latents' prior kept ({', '.join(f'{v:g}' for v in results['prior_std'][3:])} for log mu, log l); "
+                  "loss (pose NLL, nats per step) at step " + ", ".join(f"{k}: {curve[k]:.4f}" for k in marks) + "."]
+    return lines
 
 
 def _figure(results: dict, path: Path, pushes: int = 4) -> None:

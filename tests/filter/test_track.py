@@ -32,6 +32,18 @@ def test_smoke_run_writes_the_tables_and_the_figure(tmp_path):
         assert 0.0 < entry["position_rmse_mm"] < 5.0
     # The raw measurements are the testbed's motion capture: their RMSE is its noise.
     assert 0.5 < summary["raw"]["position_rmse_mm"] / (1e3 * math.sqrt(2) * REALISTIC.tracking_noise_xy) < 1.5
+    # ekf_learned: the noise learned on other pushes (seed + 1) in the scale's steps, reported beside the hand-set.
+    assert "| ekf_learned |" in (tmp_path / "results.md").read_text()
+    assert results["training_seed"] == results["seed"] + tracking.TRAINING_SEED_OFFSET
+    learning = results["noise_learning"]
+    assert learning["steps"] == tracking.SCALES["smoke"]["learn_steps"]
+    curve = learning["loss_curve"]
+    assert len(curve) == learning["steps"] + 1 and curve[-1] < curve[0]
+    hand_set, learned = results["noise"]["hand_set"], results["noise"]["learned"]
+    for key, size in (("process_std", 5), ("measurement_std", 3)):
+        assert len(hand_set[key]) == len(learned[key]) == size and hand_set[key] != learned[key]
+        assert all(value > 0 for value in learned[key])
+    np.testing.assert_allclose(hand_set["measurement_std"], results["measurement_std"])
     pushes = results["pushes"]
     assert len(pushes) == tracking.SCALES["smoke"]["pushes"]
     assert sum(push["dropped"] for push in pushes) > 0  # 20 % of the samples dropped: skipped, not zeros
