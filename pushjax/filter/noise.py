@@ -67,9 +67,7 @@ class PushBatch:
     true poses.
 
     Attributes:
-      pusher: [N, T + 1, 2] pusher centre at the filter's steps, world, m; a pusher standing still must not move
-        at all (a step of float noise, e.g. 1e-16 m, makes the gradient NaN: see
-        :data:`pushjax.filter.tracking.STANDSTILL_M`).
+      pusher: [N, T + 1, 2] pusher centre at the filter's steps, world, m.
       measurements: [N, T + 1, 3] measured poses (x m, y m, yaw rad); NaN rows are dropped samples or padding.
       truth: [N, T + 1, 3] true poses (x m, y m, yaw rad).
       valid: [N, T + 1] bool, the step belongs to the push (False: padding).

@@ -59,11 +59,6 @@ mean NEES 5.8). Evaluate on other seeds."""
 LATENT_PRIOR_STD = (0.5, 0.3)
 """Prior standard deviations of log mu and log l; the pose's prior is the first measurement with the measurement
 noise (:func:`pushjax.filter.noise.initial_belief`)."""
-STANDSTILL_M = 1e-9
-"""A pusher step shorter than this (m) is the pusher standing still, made exactly zero for the filters: the testbed's
-pusher standing after its push moves by float noise (1e-25 to 1e-16 m a step), where the derivative of the rollout
-step's Jacobian with respect to the state (reverse mode, float32; :func:`pushjax.filter.noise.learn` needs it) is
-NaN, and finite at exactly zero. Far below a moving pusher's step (2 mm at 20 mm/s and 10 Hz)."""
 ACCELERATION_PSD = (1e-4, 1e-4, 1e-1)
 """Constant-velocity filter: white acceleration spectral densities ((m/s^2)^2 s, (m/s^2)^2 s, (rad/s^2)^2 s)."""
 
@@ -136,16 +131,6 @@ def _pad(arrays: list[np.ndarray], length: int, fill: str) -> np.ndarray:
     return np.stack(padded)
 
 
-def _held_when_still(path: np.ndarray) -> np.ndarray:
-    """[T + 1, 2] the pusher `path` with every step shorter than :data:`STANDSTILL_M` made exactly zero (the pusher
-    held where it was)."""
-    held = np.array(path, np.float64)
-    for k in range(1, len(held)):
-        if np.hypot(*(path[k] - held[k - 1])) < STANDSTILL_M:
-            held[k] = held[k - 1]
-    return held
-
-
 def _first_time_within(estimate: np.ndarray, truth: float, valid: int, dt: float, tolerance: float = 0.2):
     """Seconds after which the estimate [T] stays within `tolerance` (relative) of `truth`; None if it never does."""
     inside = np.abs(np.log(estimate[:valid] / truth)) < np.log1p(tolerance)
@@ -158,8 +143,7 @@ def _first_time_within(estimate: np.ndarray, truth: float, valid: int, dt: float
 def batches_by_object(
         pushes: Sequence[TrackedPush]) -> list[tuple[models.System, list[TrackedPush], noise.PushBatch]]:
     """The pushes grouped by object (sorted by name): each group's system (nominal mu and l, default noise), its
-    pushes and their :class:`~pushjax.filter.noise.PushBatch`, padded to the group's longest push; the pusher held
-    exactly where it stands still (:data:`STANDSTILL_M`)."""
+    pushes and their :class:`~pushjax.filter.noise.PushBatch`, padded to the group's longest push."""
     groups = []
     for obj in sorted({push.obj for push in pushes}):
         group = [push for push in pushes if push.obj == obj]
@@ -168,7 +152,7 @@ def batches_by_object(
             raise ValueError(f"{obj}: the pushes declare different nominal mu {sorted(set(nominal))}")
         length = max(len(push.pusher) for push in group)
         batch = noise.PushBatch(
-            pusher=_pad([_held_when_still(push.pusher) for push in group], length, "edge"),
+            pusher=_pad([push.pusher for push in group], length, "edge"),
             measurements=_pad([push.measurements for push in group], length, "nan"),
             truth=_pad([push.truth for push in group], length, "edge"),
             valid=np.stack([np.arange(length) < len(push.pusher) for push in group]))

@@ -50,6 +50,10 @@ _DISTANCE_TOLERANCE = 1e-12
 """m; as in :mod:`pushjax.geometry.contact`: a start this much farther than r from the outline still touches."""
 _TIME_TOLERANCE = 1e-12
 """Hit times this far below 0 count as 0."""
+_MIN_SQUARED_LENGTH = 1e-30
+"""Squared length (m^2) at or below which a vector has no direction: a pusher motion shorter than 1 fm is no motion
+(float32's squares of such lengths are subnormal or zero, where the hit times' second derivatives overflow), a
+normal that short falls back to the edge's."""
 
 
 class Outline(NamedTuple):
@@ -155,7 +159,7 @@ def _safe_sqrt(value):
 def _unit_or(vector, fallback):
     """`vector` normalised, or `fallback` where its length is (near) zero; finite gradients."""
     squared = _dot(vector, vector)
-    usable = squared > 1e-30
+    usable = squared > _MIN_SQUARED_LENGTH
     length = jnp.sqrt(jnp.where(usable, squared, 1.0))
     return jnp.where(usable[..., None], vector / length[..., None], fallback)
 
@@ -187,6 +191,7 @@ def first_contact(shape: Outline, pusher, motion, radius=PUSHER_RADIUS) -> Conta
         raise ValueError(f"pusher, motion: expected shape [2] each (vmap for batches), got {pusher.shape}, "
                          f"{motion.shape}")
     r = jnp.asarray(radius, shape.start.dtype)
+    motion = jnp.where(_dot(motion, motion) > _MIN_SQUARED_LENGTH, motion, 0.0)
     # Which features: decided over all of them without derivatives (a branch choice), then the chosen features'
     # quantities are computed again from their vertices alone, so derivatives cost O(1) instead of O(V).
     fixed = jax.lax.stop_gradient((shape, pusher, motion, r))

@@ -78,9 +78,10 @@ def _normal_push_ending_still(moving: int = 12, still: int = 3, step: float = 2e
     return np.concatenate([moving_path, moving_path[-1] + jitter])
 
 
-def test_a_pusher_standing_still_is_held_exactly_and_keeps_the_gradient_finite():
+def test_a_pusher_standing_still_up_to_float_noise_keeps_the_gradient_finite():
     # Two pushes of the tests' size (16 samples at 5 Hz) along rect1's normal through its middle, by the analytical
-    # rollout: in contact, a pusher moving by float noise makes the derivative of the EKF's Jacobian NaN.
+    # rollout: in contact, a pusher moving by float noise once made the derivative of the EKF's Jacobian NaN
+    # (pushjax.geometry.outline_jax now treats a motion under 1 fm as none).
     system = models.make_system("rect1", mu=0.25)
     path = _normal_push_ending_still()
     truth = np.asarray(metrics.simulate(system, np.zeros((1, 5)), path[None]), np.float64)[0]
@@ -88,11 +89,7 @@ def test_a_pusher_standing_still_is_held_exactly_and_keeps_the_gradient_finite()
                                    measurements=metrics.measure(truth, HAND_SET_MEASUREMENT_STD, 0.0, seed=k),
                                    truth=truth, mu_nominal=0.25, mu_true=0.25) for k in range(2)]
     ((system, _, batch),) = tracking.batches_by_object(pushes)
-    assert np.all(np.diff(batch.pusher[:, -4:], axis=1) == 0.0) and np.all(batch.pusher[:, :-3] == path[:-3])
+    assert np.all(batch.pusher == path) and np.any(np.diff(batch.pusher[:, -4:], axis=1) != 0.0)
     starting, latent_prior_std = _problem(1.0)[:2]
     _, gradient = noise.loss_and_gradient(starting, latent_prior_std, (system,), (batch,))
     assert all(np.all(np.isfinite(leaf)) for leaf in jax.tree_util.tree_leaves(gradient))
-    # The float noise fed to the filter as it is: NaN, and learning says so.
-    jittery = batch.replace(pusher=np.stack([path, path]))
-    with pytest.raises(FloatingPointError, match="not finite at step 0"):
-        noise.learn(starting, latent_prior_std, (system,), (jittery,), steps=1)
