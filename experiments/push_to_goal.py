@@ -17,7 +17,6 @@ from absl import app, flags
 import experiments
 from pushjax.control import closed_loop, mpc, push_to_goal, report
 from pushjax.geometry.objects import OBJECT_NAMES
-from pushjax.physics import model_file
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
 
@@ -75,7 +74,6 @@ def _parse_models(names):
 
 
 flags.register_validator("models", _parsed_by(_parse_models))
-flags.register_validator("loop_model", _parsed_by(lambda path: path is None or model_file.read(path)))
 flags.register_multi_flags_validator(
     ["models", "loop_model"], lambda values: (push_to_goal.LOOP_MODEL in values["models"]) == bool(values["loop_model"]),
     f"--loop_model: expected exactly when --models has '{push_to_goal.LOOP_MODEL}'")
@@ -90,9 +88,12 @@ def main(argv):
     scale = push_to_goal.SCALES[_SCALE.value]
     loop = closed_loop.LoopConfig(max_time=_MAX_TIME.value or scale["max_time"], surface=_SURFACE.value,
                                   testbed=testbed, effects=Effects.parse(_EFFECTS.value))
-    results = push_to_goal.run(_WORKDIR.value, _OBJECTS.value or scale["objects"], _GOALS.value or scale["goals"],
-                               _MODELS.value, _PLANNERS.value or scale["planners"], _SEED.value, loop,
-                               _EFFECT_PARAMS.value, scale["controller"], _LOOP_MODEL.value)
+    try:
+        results = push_to_goal.run(_WORKDIR.value, _OBJECTS.value or scale["objects"],
+                                   _GOALS.value or scale["goals"], _MODELS.value, _PLANNERS.value or scale["planners"],
+                                   _SEED.value, loop, _EFFECT_PARAMS.value, scale["controller"], _LOOP_MODEL.value)
+    except push_to_goal.ModelFileError as error:
+        raise app.UsageError(f"--loop_model: {error}") from None
     results["settings"]["scale"] = _SCALE.value
     paths = report.write(results, _WORKDIR.value)
     print(paths[1].read_text())

@@ -29,7 +29,7 @@ from pushjax.physics import effects as effects_lib
 from pushjax.physics import model_file
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
 
-__all__ = ["SCALES", "model_effects", "parse_effect_params", "run"]
+__all__ = ["LOOP_MODEL", "SCALES", "ModelFileError", "model_effects", "parse_effect_params", "run"]
 
 SCALES = {
     "smoke": {"objects": ("rect1",), "goals": 2, "planners": ("gradient",), "max_time": 30.0,
@@ -44,6 +44,10 @@ SCALES = {
 a shorter horizon, fewer planner iterations and contact candidates, which compile and plan faster)."""
 TRAJECTORY_STRIDE = 5
 """Control periods between the poses kept for the figure."""
+
+
+class ModelFileError(ValueError):
+    """The pushing model file of the ``loop`` model cannot be read as one."""
 
 
 LOOP_MODEL = "loop"
@@ -119,7 +123,8 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
       loop_model: the pushing model file of the ``loop`` model (needed when `models` has it).
 
     Raises:
-      ValueError: ``loop`` among `models` without `loop_model`, or a bad model file; one line.
+      ValueError: ``loop`` among `models` without `loop_model`; ModelFileError (a ValueError): a bad model file;
+        one line.
     """
     params = parse_effect_params(effect_params)
     specs = {}
@@ -130,7 +135,10 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
     if LOOP_MODEL in models:
         if loop_model is None:
             raise ValueError(f"loop_model: the model {LOOP_MODEL!r} needs a pushing model file")
-        specs[LOOP_MODEL] = model_file.read(loop_model)
+        try:
+            specs[LOOP_MODEL] = model_file.read(loop_model)
+        except ValueError as error:
+            raise ModelFileError(str(error)) from None
     tasks = goals.draw_goals(objects, goals_per_object, seed)
     settings = {"seed": seed, "loop": dataclasses.asdict(loop), "effect_params": effect_params,
                 "controller": repr(controller)}
