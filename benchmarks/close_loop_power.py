@@ -50,7 +50,7 @@ from scipy import stats
 
 import jax.numpy as jnp
 
-from pushjax.geometry import get_object, support_cells, support_feet
+from pushjax.geometry import get_object, support
 from pushjax.loop import fit as fit_lib
 from pushjax.loop import metrics
 from pushjax.loop.pipeline import LoopSettings, decide
@@ -61,27 +61,37 @@ from pushjax.sim.dataset import RecordingSettings, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.testbed import IDEAL
 
-CASES = {  # name: (support, testbed effects)
-    "clean": ("grid", ""),
-    "clean_feet": ("hull", ""),
-    "clean_ring": ("ring", ""),
-    "com_offset_s": ("grid", "com_offset=0.004,-0.003"),
-    "com_offset_l": ("grid", "com_offset=0.008,-0.005"),
-    "pusher_friction_s": ("grid", "pusher_friction=0.4"),
-    "pusher_friction_l": ("grid", "pusher_friction=0.6"),
-    "table_tilt_s": ("grid", "table_tilt_deg=3;table_tilt_azimuth_deg=60"),
-    "table_tilt_l": ("grid", "table_tilt_deg=5;table_tilt_azimuth_deg=60"),
-    "pressure_centre": ("grid", "pressure_rim=-3"),
-    "pressure_rim": ("grid", "pressure_rim=3"),
+CASES = {  # name: (support, testbed effects, start poses)
+    "clean": ("grid", "", "fixed"),
+    "clean_feet": ("hull", "", "fixed"),
+    "clean_ring": ("ring", "", "fixed"),
+    "com_offset_s": ("grid", "com_offset=0.004,-0.003", "fixed"),
+    "com_offset_l": ("grid", "com_offset=0.008,-0.005", "fixed"),
+    "pusher_friction_s": ("grid", "pusher_friction=0.4", "fixed"),
+    "pusher_friction_l": ("grid", "pusher_friction=0.6", "fixed"),
+    "table_tilt_s": ("grid", "table_tilt_deg=3;table_tilt_azimuth_deg=60", "fixed"),
+    "table_tilt_l": ("grid", "table_tilt_deg=5;table_tilt_azimuth_deg=60", "fixed"),
+    "pressure_centre": ("grid", "pressure_rim=-3", "fixed"),
+    "pressure_rim": ("grid", "pressure_rim=3", "fixed"),
+    "clean_scattered": ("grid", "", "scattered"),
+    "com_offset_scattered": ("grid", "com_offset=0.004,-0.003", "scattered"),
 }
-CLEAN = ("clean", "clean_feet", "clean_ring")
+CLEAN = ("clean", "clean_feet", "clean_ring", "clean_scattered")
+SUPPLEMENTARY = ("clean_scattered", "com_offset_scattered")
+"""Cases added after the goal was set, to ask whether the small centre-of-mass offset, confounded with a table-fixed
+friction field from the MIT protocol's one start pose, is found from scattered start poses
+(``pushjax.sim.dataset.START_POSES``); reported beside the goal, not counted in it."""
 REAL_DIFFERENCES = {"limit_surface", "inertia"}
 RIGHT_FIRST = {"com_offset": {"cof_offset", "pressure_gradient"}, "table_tilt": {"table_tilt"}}
 SENSOR_TOLERANCE = 0.1
 """Largest relative error of the force sensor's pusher friction that counts as found."""
 SETUPS = {  # name: (objects, surfaces, velocities in mm/s, cases)
-    "development": (["hex", "butter"], ["plywood"], (20.0, 50.0), [case for case in CASES if case != "clean_ring"]),
+    "development": (["hex", "butter"], ["plywood"], (20.0, 50.0),
+                    [case for case in CASES if case != "clean_ring" and case not in SUPPLEMENTARY]),
     "held_out": (["tri2", "ellip3"], ["delrin"], (15.0, 40.0), list(CASES)),
+}
+GOAL_CASES = {  # the cases the goal is judged on
+    setup: [case for case in cases if case not in SUPPLEMENTARY] for setup, (_, _, _, cases) in SETUPS.items()
 }
 PUSHES_PER_OBJECT = 100
 POWER_GOAL, FALSE_DISCOVERY_GOAL, ADDED_ERROR_FOR_GOAL = 0.9, 0.05, 0.2
@@ -95,11 +105,11 @@ def analyse(data_dir: Path, setup: str, case: str, seed: int, cached_only: bool 
         return json.loads(path.read_text())
     if cached_only:
         return None
-    support, effects = CASES[case]
+    support, effects, start_poses = CASES[case]
     pushes = data_dir / case / f"seed{seed}"
     objects, surfaces, velocities, _ = SETUPS[setup]
     settings = RecordingSettings(seed=seed, velocities=velocities, effects=Effects.parse(effects),
-                                 declare_effects=False, support=support, testbed=IDEAL)
+                                 declare_effects=False, support=support, testbed=IDEAL, start_poses=start_poses)
     record_pushes(pushes, objects, surfaces, PUSHES_PER_OBJECT, settings, workers=1, progress=False)
     start = time.perf_counter()
     examples = build_examples(iter_pushes(pushes))[0]
@@ -126,14 +136,10 @@ def outwardness(limit_surface: dict, objects: list[str]) -> float:
     params = {name: jnp.asarray(limit_surface[name]["value"]) for name in ("rim", "feet")}
     ratios = []
     for name in objects:
-        cells, areas, _ = support_cells(get_object(name))
-        corners, loads = support_feet(get_object(name))
-        points = np.concatenate([cells, corners])
-        pressure = np.asarray(support_pressure(params, jnp.asarray(points),
-                                               jnp.asarray(np.concatenate([areas, np.zeros(len(corners))])),
-                                               jnp.asarray(np.concatenate([np.zeros(len(cells)), loads]))))
+        points, areas, loads, _ = support(get_object(name))
+        pressure = np.asarray(support_pressure(params, *map(jnp.asarray, (points, areas, loads))))
         square = np.sum(points ** 2, axis=1)
-        ratios.append(pressure @ square / (areas @ square[:len(cells)] / areas.sum()))
+        ratios.append(pressure @ square / (areas @ square / areas.sum()))
     return float(np.mean(ratios))
 
 
@@ -194,20 +200,23 @@ def main():
         print("no clean data set analysed (the added error of every case is measured against it): no table")
         return
     clean = np.mean([outcome["plain_score"] for outcome in outcomes["clean"]])
-    print("\n| case | support | testbed effect | plain model sum % | added error | data sets | found | anything beyond "
-          "limit_surface, inertia | selections |")
-    print("|---|---|---|---:|---:|---:|---:|---:|---|")
+    print("\n| case | support | testbed effect | start poses | plain model sum % | added error | data sets | found | "
+          "anything beyond limit_surface, inertia | selections |")
+    print("|---|---|---|---|---:|---:|---:|---:|---:|---|")
     met, wrong, clean_total = True, 0, 0
     for case in cases:
-        support, effects = CASES[case]
+        support, effects, start_poses = CASES[case]
         results = outcomes[case]
         added = np.mean([outcome["plain_score"] for outcome in results]) / clean - 1
         beyond = np.mean([bool(false_discoveries(outcome)) for outcome in results])
         listing = "; ".join("+".join(outcome["selected"]) or "-" for outcome in results)
         power = None if case in CLEAN else np.mean([found(args.setup, case, outcome) for outcome in results])
-        print(f"| {case} | {support} | {effects or '-'} | {np.mean([o['plain_score'] for o in results]):.1f} | "
+        print(f"| {case} | {support} | {effects or '-'} | {start_poses} | "
+              f"{np.mean([o['plain_score'] for o in results]):.1f} | "
               f"{added:+.0%} | {len(results)} | {'-' if power is None else f'{power:.0%}'} | {beyond:.0%} | "
               f"{listing} |")
+        if case in SUPPLEMENTARY:
+            continue
         if case in CLEAN:
             wrong += sum(bool(false_discoveries(outcome)) for outcome in results)
             clean_total += len(results)
@@ -215,8 +224,9 @@ def main():
             met &= power >= POWER_GOAL
     rate = wrong / clean_total
     met &= rate <= FALSE_DISCOVERY_GOAL
-    complete = len(cases) == len(setup_cases) and not args.cached_only
-    judged = "" if complete else f" (judged on the analyses of {', '.join(cases)} only)"
+    complete = set(GOAL_CASES[args.setup]) <= set(cases) and not args.cached_only
+    judged = "" if complete else (f" (judged on the analyses of "
+                                  f"{', '.join(c for c in cases if c not in SUPPLEMENTARY)} only)")
     print(f"\nfalse discoveries on clean data: {wrong} of {clean_total} ({rate:.0%}; one-sided 95 % upper bound "
           f"{upper_bound(wrong, clean_total):.0%})")
     print(f"goal (power >= {POWER_GOAL:.0%} where the added error >= {ADDED_ERROR_FOR_GOAL:.0%}, false discoveries <= "
