@@ -51,7 +51,8 @@ def _summary(rows: Sequence[dict]) -> dict:
 
 
 def compare(rows: Sequence[dict], baseline: str, model: str, max_time: float) -> dict:
-    """`model` against `baseline` on the goals both were given (paired by planner, object and goal), decided by
+    """`model` against `baseline` on the goals both were given (paired by planner, object and goal; a goal's
+    differences averaged over its planners, so that the goals are the independent unit), decided by
     :data:`pushjax.control.goals.COMPARISON_STANDARD_ERRORS`.
 
     Returns:
@@ -69,15 +70,18 @@ def compare(rows: Sequence[dict], baseline: str, model: str, max_time: float) ->
     def time_to_success(row):
         return row["time_s"] if row["success"] else max_time
 
+    tasks = sorted({key[1:] for key in keys})  # the goals; a goal's planners are averaged, not counted apart
+
     def paired(value):
-        difference = np.array([value(ours[key]) - value(theirs[key]) for key in keys])
-        error = float(np.std(difference, ddof=1) / math.sqrt(len(keys))) if len(keys) > 1 else math.inf
-        return {"mean": float(np.mean(difference)) if keys else math.nan, "standard_error": error}
+        difference = np.array([np.mean([value(ours[key]) - value(theirs[key]) for key in keys if key[1:] == task])
+                               for task in tasks])
+        error = float(np.std(difference, ddof=1) / math.sqrt(len(tasks))) if len(tasks) > 1 else math.inf
+        return {"mean": float(np.mean(difference)) if tasks else math.nan, "standard_error": error}
 
     time = paired(time_to_success)
     margin = goals.COMPARISON_STANDARD_ERRORS * time["standard_error"]
     verdict = "better" if time["mean"] < -margin else "worse" if time["mean"] > margin else "not decided"
-    return {"model": model, "baseline": baseline, "goals": len(keys), "time_to_success_difference_s": time,
+    return {"model": model, "baseline": baseline, "goals": len(tasks), "time_to_success_difference_s": time,
             "position_error_difference_mm": paired(lambda row: row["position_error_mm"]),
             "only_model_succeeded": sum(ours[key]["success"] and not theirs[key]["success"] for key in keys),
             "only_baseline_succeeded": sum(theirs[key]["success"] and not ours[key]["success"] for key in keys),

@@ -50,3 +50,13 @@ def test_a_model_that_reaches_the_same_goals_sooner_is_better_and_a_failure_coun
     assert mixed["verdict"] == "not decided" and mixed["only_baseline_succeeded"] == 1
     text = report.table(report.summarise(rows, {"loop": {"max_time": 60.0}}))
     assert "| loop − lynch | 6 |" in text and "not decided" in text
+
+
+def test_a_goal_planned_by_two_planners_is_one_independent_unit():
+    rows = [_row(model, "rect1", index, 1.0, 0.5) | {"planner": planner, "time_s": time + index}
+            for index in range(4) for planner in ("gradient", "sampling")
+            for model, time in (("lynch", 30.0), ("loop", 28.0 if planner == "gradient" else 26.0))]
+    result = report.compare(rows, "lynch", "loop", max_time=60.0)
+    assert result["goals"] == 4
+    np.testing.assert_allclose(result["time_to_success_difference_s"]["mean"], -3.0)
+    assert result["time_to_success_difference_s"]["standard_error"] == 0.0
