@@ -72,10 +72,10 @@ def make_model(obj: PushObject | str, mu: float = 0.25, l: float | None = None, 
             raise ValueError(f"params: {name} has no parameter(s) {', '.join(extra)}; it has {', '.join(full[name])}")
         full[name] = {**full[name], **values}
     full = jax.tree_util.tree_map(lambda value: jnp.asarray(value, dtype), full)
-    exact = any(effects_lib.EFFECTS[name].solve is not None for name in effects)
     return PushModel(shape=outline_jax.outline(obj, dtype), l=jnp.asarray(l, dtype), mu=jnp.asarray(mu, dtype),
                      radius=jnp.asarray(PUSHER_RADIUS, dtype), params=full,
-                     support=rollout.object_support(obj, dtype) if exact else None, effects=effects)
+                     support=rollout.object_support(obj, dtype) if effects_lib.needs_support(effects) else None,
+                     effects=effects)
 
 
 def predict(model: PushModel, pose, pusher_path) -> rollout.Rollout:

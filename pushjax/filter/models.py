@@ -100,12 +100,12 @@ def make_system(obj: PushObject | str, mu: float = 0.25, l: float | None = None,
         raise ValueError(f"mu, l: expected positive nominal values, got {mu}, {l}")
     effects = tuple(effects)
     params = effects_lib.init_params(effects) if params is None else params
-    exact = any(effects_lib.EFFECTS[name].solve is not None for name in effects)
     return System(shape=outline_jax.outline(obj, dtype, ellipse_points), l=jnp.asarray(l, dtype),
                   mu=jnp.asarray(mu, dtype), process_std=jnp.asarray(process_std, dtype),
                   measurement_std=jnp.asarray(measurement_std, dtype), radius=jnp.asarray(PUSHER_RADIUS, dtype),
                   params=jax.tree_util.tree_map(lambda x: jnp.asarray(x, dtype), params),
-                  support=rollout.object_support(obj, dtype) if exact else None, effects=effects)
+                  support=rollout.object_support(obj, dtype) if effects_lib.needs_support(effects) else None,
+                  effects=effects)
 
 
 def transition(system: System, state, pusher, increment):

@@ -125,6 +125,7 @@ __all__ = [
     "compose",
     "init_params",
     "limit_surface_predict",
+    "needs_support",
     "physical_params",
     "project_params",
     "support_pressure",
@@ -559,6 +560,12 @@ EFFECT_NAMES = tuple(EFFECTS)
 ELLIPSOID_EFFECTS = tuple(name for name in EFFECT_NAMES if EFFECTS[name].solve is None)
 """The effects that keep Lynch's ellipsoidal limit surface: any of them compose, and their zero parameters are
 Lynch's model."""
+
+
+def needs_support(names: Sequence[str]) -> bool:
+    """Whether the named effects include one that solves the exact limit surface and so needs the object's support
+    (:attr:`PushInputs.support_points`)."""
+    return any(EFFECTS[name].solve is not None for name in names)
 
 
 def compatible(names: Sequence[str]) -> bool:

@@ -178,7 +178,7 @@ def rollout(shape: outline_jax.Outline, object_pose, pusher_path, l, mu, params=
     """
     effects = tuple(effects)
     predict = effects_lib.compose(effects)
-    if support is None and any(effects_lib.EFFECTS[name].solve is not None for name in effects):
+    if support is None and effects_lib.needs_support(effects):
         raise ValueError(f"support: effects {effects} include the exact limit surface, which needs the object's "
                          "support (rollout.object_support(obj))")
     params = effects_lib.init_params(effects) if params is None else params
