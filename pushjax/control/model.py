@@ -16,6 +16,7 @@ import jax.numpy as jnp
 from pushjax.geometry import outline_jax
 from pushjax.geometry.objects import PUSHER_RADIUS, PushObject, get_object, limit_surface_ratio
 from pushjax.physics import effects as effects_lib
+from pushjax.physics import model_file
 from pushjax.physics import rollout
 
 __all__ = ["PushModel", "make_model", "predict"]
@@ -62,15 +63,7 @@ def make_model(obj: PushObject | str, mu: float = 0.25, l: float | None = None, 
     if not (jnp.isfinite(mu) and mu > 0 and jnp.isfinite(l) and l > 0):
         raise ValueError(f"mu, l: expected positive finite values, got {mu}, {l}")
     effects = tuple(effects)
-    full = effects_lib.init_params(effects)
-    unknown = sorted(set(params or {}) - set(full))
-    if unknown:
-        raise ValueError(f"params: effect(s) {', '.join(unknown)} not among the composed effects {effects}")
-    for name, values in (params or {}).items():
-        extra = sorted(set(values) - set(full[name]))
-        if extra:
-            raise ValueError(f"params: {name} has no parameter(s) {', '.join(extra)}; it has {', '.join(full[name])}")
-        full[name] = {**full[name], **values}
+    full = model_file.AugmentedModel.create(effects, params, mu).params  # filled up and checked
     full = jax.tree_util.tree_map(lambda value: jnp.asarray(value, dtype), full)
     return PushModel(shape=outline_jax.outline(obj, dtype), l=jnp.asarray(l, dtype), mu=jnp.asarray(mu, dtype),
                      radius=jnp.asarray(PUSHER_RADIUS, dtype), params=full,
