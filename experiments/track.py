@@ -2,12 +2,20 @@ r"""Track pushes of the testbed with the EKF, UKF and particle filter, and infer
 
   python -m experiments.track --workdir=work/track [--scale=smoke|cpu] [--filters=ekf,ukf,particle,ekf_learned]
       [--seed=0] [--rate_hz=10] [--learn_steps=200] [--testbed=realistic|ideal] [--testbed_overrides='drop_rate=0.1']
+      [--perception=<a trained model's work directory or checkpoint> [--perception_hz=2.5] [--perception_scale=cpu]]
 
 Simulates the scale's pushes in memory (``pushjax.filter.tracking``: the truth only the simulation knows), filters
 the tracked poses, and writes ``results.json``, ``results.md`` (pose RMSE against the raw measurements and a
 constant-velocity filter, NEES in its 95 % band, the pusher friction against its drawn value, the hand-set and the
 learned noise) and ``mu_over_time.png`` to ``--workdir``. ``ekf_learned`` learns its noise on as many other pushes,
 simulated with seed ``--seed`` + 1, before the pushes of ``--seed`` are filtered.
+
+``--perception`` adds a second observation stream: the object's centre of mass that the trained model's perception
+locates in the depth image of the true scene, rendered at ``--perception_hz`` as the model's dataset
+(``data_efficiency`` at ``--perception_scale``) renders its examples (``pushjax.sensing.perception``); its noise is
+estimated on the pushes of seed ``--seed`` + 1, never on the evaluated ones. Rows ``ekf_perception`` (motion capture
+and perception), ``ekf_perception_only`` (perception after the first motion-capture sample) and ``perception`` (the
+readings themselves). The model's folder is only read.
 """
 
 import math
@@ -15,7 +23,9 @@ import math
 from absl import app, flags
 
 import experiments
+from pushjax.data import configs as data_configs
 from pushjax.filter import tracking
+from pushjax.sensing import perception
 
 _WORKDIR = flags.DEFINE_string("workdir", None, "Folder for results.json, results.md and the figure.", required=True)
 _SCALE = flags.DEFINE_enum("scale", "cpu", list(tracking.SCALES), "Objects, pushes and particles (smoke: a test).")
@@ -28,6 +38,14 @@ _LEARN_STEPS = flags.DEFINE_integer("learn_steps", None,
 _TESTBED = experiments.define_testbed_flag()
 _TESTBED_OVERRIDES = flags.DEFINE_string(
     "testbed_overrides", "", "Magnitudes of the testbed profile to change, e.g. 'drop_rate=0.1'.")
+_PERCEPTION = flags.DEFINE_string(
+    "perception", None, "A trained model's work directory or checkpoint (pushjax.train.predictor.load_model; its last "
+    "model): its perception's object position becomes a second observation stream of the EKF.")
+_PERCEPTION_HZ = flags.DEFINE_float("perception_hz", 2.5, "Rate of the perception readings, Hz: the filter rate "
+                                    "divided by a whole number.")
+_PERCEPTION_SCALE = flags.DEFINE_enum("perception_scale", "cpu", list(data_configs.SCALES),
+                                      "Scale of the data_efficiency dataset the --perception model was trained on (its "
+                                      "camera and image size render the scenes).")
 experiments.require_writable_folder("workdir")
 
 
@@ -60,16 +78,29 @@ def main(argv):
     learns = "ekf_learned" in _FILTERS.value
     if _LEARN_STEPS.value is not None and not learns:
         raise app.UsageError("--learn_steps: only used by ekf_learned, which --filters leaves out")
+    every = rate / _PERCEPTION_HZ.value
+    if _PERCEPTION.value is not None and not (_PERCEPTION_HZ.value > 0 and abs(every - round(every)) < 1e-9):
+        raise app.UsageError(f"--perception_hz: expected the filter rate {rate:g} Hz divided by a whole number, got "
+                             f"{_PERCEPTION_HZ.value:g}")
+    sensor = None
+    if _PERCEPTION.value is not None:
+        try:
+            sensor = perception.load(_PERCEPTION.value, data_configs.get_config("data_efficiency",
+                                                                                _PERCEPTION_SCALE.value))
+        except ValueError as error:
+            raise app.UsageError(f"--perception: {' '.join(str(error).split())}") from None
     pushes = tracking.simulate_pushes(scale["objects"], scale["pushes"], _SEED.value, testbed, rate)
     training_seed = _SEED.value + tracking.TRAINING_SEED_OFFSET
     training_pushes = (tracking.simulate_pushes(scale["objects"], scale["pushes"], training_seed, testbed, rate)
-                       if learns else [])
+                       if learns or sensor is not None else [])
+    readings = (perception.stream(sensor, pushes, training_pushes, round(every), rate, training_seed)
+                if sensor is not None else None)
     measurement_std = (max(testbed.tracking_noise_xy, 1e-5), max(testbed.tracking_noise_xy, 1e-5),
                        max(testbed.tracking_noise_yaw, 1e-4))
     results = tracking.run(pushes, _FILTERS.value, rate, scale["particles"], _SEED.value, measurement_std,
-                           training_pushes, _LEARN_STEPS.value or scale["learn_steps"])
+                           training_pushes if learns else (), _LEARN_STEPS.value or scale["learn_steps"], readings)
     results.update(scale=_SCALE.value, seed=_SEED.value, testbed=testbed.to_dict())
-    if learns:
+    if learns or sensor is not None:
         results.update(training_seed=training_seed)
     paths = tracking.write(results, _WORKDIR.value)
     print(paths[1].read_text())

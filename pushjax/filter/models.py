@@ -15,6 +15,14 @@ Observation model (:func:`observe`): the pose, as a motion-capture system measur
 (:attr:`System.measurement_std`). A dropped sample is a row of NaN (any NaN in the row): the filters skip the
 update there (predict only), they never read it as a zero. Yaw innovations are wrapped to (-pi, pi].
 
+A second observation model (:class:`PositionSensor`, :func:`observe_position`, :func:`update_position`): the world
+position of a point fixed on the object (the centre of mass, as a trained perception network locates it in a depth
+image: ``pushjax.sensing.perception``), with its own Gaussian noise (:attr:`PositionSensor.std`) and no orientation.
+It is nonlinear in the state (the point turns with the yaw), so the Gaussian filters update with it linearised at
+the predicted mean (the EKF's update, ``jax.jacfwd`` of :func:`observe_position`). A missing reading is NaN and
+skipped, like a dropped pose; where both streams have a sample, the pose update comes first, then the position
+update (independent noises: the order does not matter for a linear update).
+
 Units: SI (m, rad). All functions are per push and pure; ``jax.vmap`` the filters over pushes.
 """
 
@@ -33,12 +41,14 @@ from pushjax.geometry.objects import PUSHER_RADIUS, PushObject, get_object, limi
 from pushjax.physics import effects as effects_lib
 from pushjax.physics import rollout
 
-__all__ = ["POSE_SIZE", "STATE_NAMES", "STATE_SIZE", "System", "Track", "innovation", "make_system", "observe",
-           "observed", "physical", "transition", "update_linear"]
+__all__ = ["POSE_SIZE", "POSITION_SIZE", "STATE_NAMES", "STATE_SIZE", "PositionSensor", "System", "Track",
+           "innovation", "make_position_sensor", "make_system", "observe", "observe_position", "observed", "physical",
+           "transition", "update", "update_linear", "update_position"]
 
 STATE_NAMES = ("x", "y", "yaw", "log_mu_scale", "log_l_scale")
 STATE_SIZE = len(STATE_NAMES)
 POSE_SIZE = 3
+POSITION_SIZE = 2
 
 
 @flax.struct.dataclass
@@ -151,23 +161,84 @@ def update_linear(system: System, mean, cov, measurement):
     return jnp.where(present, new_mean, mean), jnp.where(present, new_cov, cov)
 
 
-def gaussian_filter(predict, system: System, mean, cov, pusher_path, measurements) -> Track:
-    """A Gaussian filter over one push: the linear pose update, then ``predict`` and the update at every step.
+@flax.struct.dataclass
+class PositionSensor:
+    """The second observation model: the world position of a point fixed on the object, with Gaussian noise (a pytree).
+
+    Attributes:
+      offset: [2] the observed point in the object's tracked frame, m (the centre of mass:
+        :attr:`pushjax.geometry.objects.PushObject.centroid`).
+      std: [2] standard deviation of a reading, world x and y, m.
+    """
+
+    offset: jax.Array
+    std: jax.Array
+
+
+def make_position_sensor(obj: PushObject | str, std: Sequence[float], dtype=jnp.float32) -> PositionSensor:
+    """The :class:`PositionSensor` of `obj`'s centre of mass with reading noise `std` [2] (world x m, y m; > 0)."""
+    obj = get_object(obj) if isinstance(obj, str) else obj
+    std = np.asarray(std, np.float64)
+    if std.shape != (POSITION_SIZE,) or not np.all(np.isfinite(std) & (std > 0)):
+        raise ValueError(f"std: expected {POSITION_SIZE} positive values (m), got {std.tolist()}")
+    return PositionSensor(offset=jnp.asarray(obj.centroid, dtype), std=jnp.asarray(std, dtype))
+
+
+def observe_position(sensor: PositionSensor, state):
+    """[2] the world position of the sensor's point for the state [5] (its pose x m, y m, yaw rad)."""
+    cos, sin = jnp.cos(state[2]), jnp.sin(state[2])
+    offset = sensor.offset.astype(state.dtype)
+    return state[:2] + jnp.stack([cos * offset[0] - sin * offset[1], sin * offset[0] + cos * offset[1]])
+
+
+def update_position(sensor: PositionSensor, mean, cov, position):
+    """Kalman update of a Gaussian belief (mean [5], cov [5, 5]) with a position reading [2] (world, m), the
+    observation linearised at `mean` (the EKF's update; exact for a sensor whose point is the tracked frame's
+    origin); a missing reading (any NaN) leaves the belief unchanged. Joseph form, symmetrised."""
+    predicted = observe_position(sensor, mean)
+    h = jax.jacfwd(observe_position, argnums=1)(sensor, mean)
+    r = jnp.diag(sensor.std.astype(cov.dtype) ** 2)
+    s = h @ cov @ h.T + r
+    gain = jnp.linalg.solve(s, h @ cov).T
+    present = jnp.all(jnp.isfinite(position))
+    new_mean = mean + gain @ (jnp.where(present, position, predicted) - predicted)
+    factor = jnp.eye(STATE_SIZE, dtype=cov.dtype) - gain @ h
+    new_cov = factor @ cov @ factor.T + gain @ r @ gain.T
+    new_cov = 0.5 * (new_cov + new_cov.T)
+    return jnp.where(present, new_mean, mean), jnp.where(present, new_cov, cov)
+
+
+def update(system: System, mean, cov, measurement, sensor: PositionSensor | None = None, position=None):
+    """The update with one step's observations: the pose `measurement` [3] (:func:`update_linear`), then, with a
+    `sensor`, its `position` reading [2] (:func:`update_position`); NaN samples are skipped."""
+    mean, cov = update_linear(system, mean, cov, measurement)
+    if sensor is not None:
+        mean, cov = update_position(sensor, mean, cov, position)
+    return mean, cov
+
+
+def gaussian_filter(predict, system: System, mean, cov, pusher_path, measurements,
+                    sensor: PositionSensor | None = None, positions=None) -> Track:
+    """A Gaussian filter over one push: the update (:func:`update`), then ``predict`` and the update at every step.
 
     Args:
       predict: ``(system, mean, cov, pusher [2], increment [2]) -> (mean, cov)``, the filter's process step (EKF,
         UKF).
-      system, mean, cov, pusher_path, measurements: as in :func:`pushjax.filter.ekf.filter_push`.
+      system, mean, cov, pusher_path, measurements, sensor, positions: as in :func:`pushjax.filter.ekf.filter_push`.
     """
-    mean, cov = update_linear(system, mean, cov, measurements[0])
+    if (sensor is None) != (positions is None):
+        raise ValueError("sensor, positions: expected both (a second, position stream) or neither")
+    if positions is None:
+        positions = jnp.zeros((measurements.shape[0], 0), measurements.dtype)  # scanned over, never read
+    mean, cov = update(system, mean, cov, measurements[0], sensor, positions[0])
 
     def body(belief, inputs):
-        pusher, increment, measurement = inputs
-        belief = update_linear(system, *predict(system, *belief, pusher, increment), measurement)
+        pusher, increment, measurement, position = inputs
+        belief = update(system, *predict(system, *belief, pusher, increment), measurement, sensor, position)
         return belief, belief
 
-    _, (means, covs) = jax.lax.scan(body, (mean, cov),
-                                    (pusher_path[:-1], jnp.diff(pusher_path, axis=0), measurements[1:]))
+    _, (means, covs) = jax.lax.scan(body, (mean, cov), (pusher_path[:-1], jnp.diff(pusher_path, axis=0),
+                                                        measurements[1:], positions[1:]))
     return Track(mean=jnp.concatenate([mean[None], means]), cov=jnp.concatenate([cov[None], covs]),
                  observed=jax.vmap(observed)(measurements))
 

@@ -17,6 +17,16 @@ the realistic testbed's tracking noise as measurement noise); ``ekf_learned`` is
 measurement noise learned through the differentiable filter (:mod:`pushjax.filter.noise`), starting from the
 hand-set values, on training pushes simulated with another seed than the evaluated ones
 (:data:`TRAINING_SEED_OFFSET`).
+
+A second observation stream (:class:`PositionStream`: the object's centre of mass as a trained perception network
+locates it in the rendered depth image, made by ``pushjax.sensing.perception`` at layer 6, since this module may not
+import a trained model) adds the rows of :data:`PERCEPTION_FILTERS`: ``ekf_perception``, the EKF fusing the motion
+capture and the readings (:class:`~pushjax.filter.models.PositionSensor`, the readings' own noise), and
+``ekf_perception_only``, the EKF with the first motion-capture sample as its prior and the readings alone after
+it, beside ``ekf_prediction_only``, the EKF with nothing after the first sample (what the process model alone
+tracks, which the readings must beat to add anything); and the row ``perception``: the readings themselves against
+the true centre of mass (no yaw). Every EKF row runs
+one compiled program: the rows without readings pass an all-missing stream, which leaves them as they were.
 """
 
 from __future__ import annotations
@@ -31,15 +41,19 @@ import jax
 import matplotlib.pyplot as plt
 import numpy as np
 
-from pushjax import outputs
+from pushjax import outputs, planar
 from pushjax.filter import constant_velocity, ekf, metrics, models, noise, particle, ukf
+from pushjax.geometry.objects import get_object
 from pushjax.sim import dataset
 from pushjax.sim.testbed import Testbed
 
-__all__ = ["FILTERS", "SCALES", "TRAINING_SEED_OFFSET", "TrackedPush", "batches_by_object", "hand_set_noise",
-           "learn_noise", "run", "simulate_pushes", "write"]
+__all__ = ["FILTERS", "PERCEPTION_FILTERS", "SCALES", "TRAINING_SEED_OFFSET", "PositionStream", "TrackedPush",
+           "batches_by_object", "hand_set_noise", "learn_noise", "run", "simulate_pushes", "write"]
 
 FILTERS = ("ekf", "ukf", "particle", "ekf_learned")
+PERCEPTION_FILTERS = ("ekf_perception", "ekf_perception_only", "ekf_prediction_only")
+"""The rows a :class:`PositionStream` adds: the EKF with motion capture and the readings, with the readings alone
+after the first motion-capture sample, and, their reference, with nothing after it (the process model alone)."""
 RECORDING_RATE_HZ = 250
 SCALES = {
     "smoke": {"objects": ("rect1",), "pushes": 2, "particles": 64, "rate_hz": 5.0, "learn_steps": 3},
@@ -84,6 +98,23 @@ class TrackedPush:
     truth: np.ndarray
     mu_nominal: float
     mu_true: float
+
+
+@dataclasses.dataclass(frozen=True)
+class PositionStream:
+    """A second sensor's readings of the pushed objects' centres of mass on the filter clock, and its noise.
+
+    Attributes:
+      positions: {push name: [T + 1, 2] readings (world x m, y m) on that push's filter clock, NaN rows where the
+        sensor has none (it runs slower than the filter)}; every evaluated push needs one.
+      std: [2] standard deviation of a reading (world x m, y m), estimated on other pushes than the evaluated ones.
+      details: what ``results.json`` records about the sensor (``perception``): its model, rate and how its noise was
+        estimated.
+    """
+
+    positions: dict[str, np.ndarray]
+    std: tuple[float, float]
+    details: dict
 
 
 def _on_clock(stream: np.ndarray, indices: np.ndarray) -> np.ndarray:
@@ -182,7 +213,8 @@ def learn_noise(pushes: Sequence[TrackedPush], rate_hz: float, measurement_std: 
 
 
 def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, particles: int, seed: int,
-        measurement_std: Sequence[float], training_pushes: Sequence[TrackedPush] = (), learn_steps: int = 0) -> dict:
+        measurement_std: Sequence[float], training_pushes: Sequence[TrackedPush] = (), learn_steps: int = 0,
+        perception: PositionStream | None = None) -> dict:
     """Runs the filters and the constant-velocity baseline on the pushes; returns the results (see :func:`write`).
 
     Args:
@@ -195,7 +227,14 @@ def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, parti
       training_pushes: the pushes ``ekf_learned`` learns its noise on (required with it): other pushes than
         `pushes`, e.g. simulated with another seed (:data:`TRAINING_SEED_OFFSET`).
       learn_steps: Adam steps of ``ekf_learned``'s noise (:func:`learn_noise`).
+      perception: a second sensor's readings of the evaluated pushes (:class:`PositionStream`): adds the rows of
+        :data:`PERCEPTION_FILTERS` (hand-set noise) and ``perception``.
     """
+    if perception is not None:
+        missing = sorted({push.name for push in pushes} - set(perception.positions))
+        if missing:
+            raise ValueError(f"perception: no readings of the pushes {missing}")
+        filters = (*filters, *PERCEPTION_FILTERS)
     dt = 1.0 / rate_hz
     measurement_std = np.asarray(measurement_std, np.float64)
     hand_set = hand_set_noise(rate_hz, measurement_std)
@@ -214,6 +253,10 @@ def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, parti
         obj, count = group[0].obj, len(group)
         paths, measured, truth, valid = batch.pusher, batch.measurements, batch.truth, batch.valid
         tracks, seconds = {}, {}
+        sensor = models.make_position_sensor(obj, perception.std if perception else (1.0, 1.0))
+        no_readings = np.full(paths.shape, np.nan)
+        readings = (_pad([perception.positions[push.name] for push in group], len(paths[0]), "nan")
+                    if perception else no_readings)
         for name in filters:
             start = time.perf_counter()
             noisy = noise.with_noise(system, noises[name])
@@ -221,9 +264,15 @@ def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, parti
             if name == "particle":
                 keys = jax.random.split(jax.random.key(seed), count)
                 track = particle.filter_pushes(noisy, keys, mean, cov, paths, measured, count=particles)
-            else:
-                track = {"ekf": ekf, "ukf": ukf, "ekf_learned": ekf}[name].filter_pushes(noisy, mean, cov, paths,
-                                                                                          measured)
+            elif name == "ukf":
+                track = ukf.filter_pushes(noisy, mean, cov, paths, measured)
+            else:  # the EKF rows: one program, with the readings or an all-missing stream
+                poses = measured.copy()
+                if name in ("ekf_perception_only", "ekf_prediction_only"):
+                    poses[:, 1:] = np.nan
+                track = ekf.filter_pushes(noisy, mean, cov, paths, poses, sensor,
+                                          readings if name in ("ekf_perception", "ekf_perception_only")
+                                          else no_readings)
             tracks[name] = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(track))
             seconds[name] = time.perf_counter() - start
         cv_mean = np.concatenate([measured[:, 0], np.zeros((count, 3))], axis=-1)
@@ -245,6 +294,9 @@ def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, parti
         for name in (*filters, "constant_velocity"):
             estimates[name].append(tracks[name].mean[..., :3])
         estimates["raw"].append(measured)
+        if perception is not None:
+            true_com = planar.centre_of_mass(get_object(obj).centroid, truth)
+            estimates.setdefault("perception_errors", []).append((readings - true_com)[valid])
         truths.append(truth)
         valid_masks.append(valid)
         for name in filters:
@@ -278,6 +330,11 @@ def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, parti
             entry["mu_final_std_log_over_prior"] = float(np.mean(
                 [row["filters"][name]["mu_std_log"][-1] / LATENT_PRIOR_STD[0] for row in per_push]))
         summary[name] = entry
+    if perception is not None:
+        errors = np.concatenate(estimates["perception_errors"])
+        errors = errors[np.isfinite(errors[:, 0])]
+        summary["perception"] = {"position_rmse_mm": 1e3 * float(np.sqrt(np.mean(np.sum(errors ** 2, axis=-1)))),
+                                 "readings": len(errors)}
     process_std = _process_std_per_step(rate_hz)
     results = {"summary": summary, "pushes": per_push, "nees_band_95": [low, high], "rate_hz": rate_hz,
                "filters": list(filters), "particles": particles, "measurement_std": measurement_std.tolist(),
@@ -288,6 +345,8 @@ def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, parti
     if learning is not None:
         results["noise"]["learned"] = noise.standard_deviations(noises["ekf_learned"])
         results["noise_learning"] = learning
+    if perception is not None:
+        results["perception"] = {**perception.details, "std": list(perception.std)}
     return results
 
 
@@ -300,9 +359,10 @@ def _table(results: dict) -> str:
         mu = (f"{entry['mu_prior_abs_log_error']:.2f} → {entry['mu_final_abs_log_error']:.2f}"
               if "mu_final_abs_log_error" in entry else "")
         spread = f"{entry['mu_final_std_log_over_prior']:.2f}" if "mu_final_std_log_over_prior" in entry else ""
-        lines.append(f"| {name} | {entry['position_rmse_mm']:.3f} | {entry['yaw_rmse_deg']:.3f} | {band} | {nees} "
-                     f"| {mu} | {spread} |")
+        yaw = f"{entry['yaw_rmse_deg']:.3f}" if "yaw_rmse_deg" in entry else "–"
+        lines.append(f"| {name} | {entry['position_rmse_mm']:.3f} | {yaw} | {band} | {nees} | {mu} | {spread} |")
     lines += _noise_table(results)
+    lines += _perception_lines(results)
     header = " | ".join(f"{f}: final mu ± std(log), within 20 % after" for f in results["filters"])
     lines += ["", f"| push | mu true (nominal) | {header} |", "|---|---:|" + "---:|" * len(results["filters"])]
     for row in results["pushes"]:
@@ -350,6 +410,17 @@ def _noise_table(results: dict) -> list[str]:
                   f"latents' prior kept ({', '.join(f'{v:g}' for v in results['prior_std'][3:])} for log mu, log l); "
                   "loss (pose NLL, nats per step) at step " + ", ".join(f"{k}: {curve[k]:.4f}" for k in marks) + "."]
     return lines
+
+
+def _perception_lines(results: dict) -> list[str]:
+    """What the perception rows rest on: the model, its rate and its noise (and where that was estimated)."""
+    if "perception" not in results:
+        return []
+    info = results["perception"]
+    std = ", ".join(f"{1e3 * value:.2f}" for value in info["std"])
+    return ["", f"perception: {info['model']} at {info['rate_hz']:g} Hz; the position row `perception` is its readings "
+            f"of the centre of mass against the truth (no yaw); reading noise (x, y) {std} mm, "
+            f"{info['noise_estimated_on']}."]
 
 
 def _figure(results: dict, path: Path, pushes: int = 4) -> None:

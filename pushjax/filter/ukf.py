@@ -5,7 +5,8 @@ points at ``mean ± sqrt(n) columns of chol(P)``, non-negative mean weights) thr
 the sigma points, plus the process noise. The unscented transform sees the contact mode change within the belief's
 spread (e.g. a lower ``mu`` that slips where the mean sticks), which the EKF's Jacobian does not. Update: the
 measurement is linear in the state, so the unscented update is the Kalman update
-(:func:`~pushjax.filter.models.update_linear`), skipped for a dropped (NaN) sample.
+(:func:`~pushjax.filter.models.update_linear`), skipped for a dropped (NaN) sample; a second stream of position
+readings (:class:`~pushjax.filter.models.PositionSensor`) updates linearised, as in the EKF.
 """
 
 from __future__ import annotations
@@ -46,12 +47,15 @@ def predict(system: models.System, mean, cov, pusher, increment):
 
 
 @jax.jit
-def filter_push(system: models.System, mean, cov, pusher_path, measurements) -> models.Track:
+def filter_push(system: models.System, mean, cov, pusher_path, measurements, sensor: models.PositionSensor | None = None,
+                positions=None) -> models.Track:
     """Filters one push; arguments and result as :func:`pushjax.filter.ekf.filter_push`."""
-    return models.gaussian_filter(predict, system, mean, cov, pusher_path, measurements)
+    return models.gaussian_filter(predict, system, mean, cov, pusher_path, measurements, sensor, positions)
 
 
 @jax.jit
-def filter_pushes(system: models.System, mean, cov, pusher_paths, measurements) -> models.Track:
-    """:func:`filter_push` over a batch of pushes of one object (leading axis N on all but `system`)."""
-    return jax.vmap(filter_push, in_axes=(None, 0, 0, 0, 0))(system, mean, cov, pusher_paths, measurements)
+def filter_pushes(system: models.System, mean, cov, pusher_paths, measurements,
+                  sensor: models.PositionSensor | None = None, positions=None) -> models.Track:
+    """:func:`filter_push` over a batch of pushes of one object (leading axis N on all but `system` and `sensor`)."""
+    return jax.vmap(filter_push, in_axes=(None, 0, 0, 0, 0, None, 0))(system, mean, cov, pusher_paths, measurements,
+                                                                       sensor, positions)

@@ -1,4 +1,5 @@
-"""``python -m experiments.track --scale=smoke``: simulated testbed pushes tracked end to end."""
+"""``python -m experiments.track --scale=smoke``: simulated testbed pushes tracked end to end, with a trained hybrid
+model's perception (the committed ``results/track_perception/model``) as a second observation stream."""
 
 import json
 import math
@@ -13,12 +14,15 @@ from pushjax.filter import tracking
 from pushjax.sim.testbed import REALISTIC
 
 REPOSITORY = Path(__file__).resolve().parents[2]
+PERCEPTION_MODEL = REPOSITORY / "results" / "track_perception" / "model"
+"""A trained hybrid (``experiments.data_efficiency_full``'s hybrid_5000_seed0, cpu_full data), committed beside the
+perception run's results; a real trained network, read only."""
 
 
 def test_smoke_run_writes_the_tables_and_the_figure(tmp_path):
     result = subprocess.run(
         [sys.executable, "-m", "experiments.track", "--scale=smoke", f"--workdir={tmp_path}",
-         "--testbed_overrides=drop_rate=0.2"],
+         "--testbed_overrides=drop_rate=0.2", f"--perception={PERCEPTION_MODEL}", "--perception_scale=cpu_full"],
         cwd=REPOSITORY, env={**os.environ, "MUJOCO_GL": "egl"}, capture_output=True, text=True, timeout=600, check=False)
     assert result.returncode == 0, result.stderr[-3000:]
     assert f"wrote {tmp_path / 'results.json'}" in result.stdout
@@ -26,10 +30,22 @@ def test_smoke_run_writes_the_tables_and_the_figure(tmp_path):
     assert (tmp_path / "mu_over_time.png").stat().st_size > 1000
     assert "| ekf |" in (tmp_path / "results.md").read_text()
     summary = results["summary"]
-    assert set(summary) == {*tracking.FILTERS, "constant_velocity", "raw"}
+    assert set(summary) == {*tracking.FILTERS, *tracking.PERCEPTION_FILTERS, "constant_velocity", "raw", "perception"}
     for name, entry in summary.items():
         assert all(math.isfinite(value) for value in entry.values()), (name, entry)
         assert 0.0 < entry["position_rmse_mm"] < 5.0
+    # The perception: readings at 2.5 Hz of the 5 Hz clock (every other step), its noise from seed + 1's pushes.
+    info = results["perception"]
+    assert info["every_steps"] == 2 and info["rate_hz"] == 2.5 and "hybrid" in info["model"]
+    assert info["noise_readings"] > 10 and all(0.0 < std < 0.01 for std in info["std"])
+    assert summary["perception"]["readings"] == sum(push["steps"] // 2 + 1 for push in results["pushes"])
+    # The scenes are rendered as the model's training data were (camera, image size, pose convention): the trained
+    # network locates the centre of mass to about a millimetre (a wrong camera or pose puts it centimetres off).
+    assert summary["perception"]["position_rmse_mm"] < 2.0
+    # Perception alone after the first motion-capture sample is not the process model alone: the readings are used.
+    alone, open_loop = summary["ekf_perception_only"], summary["ekf_prediction_only"]
+    assert alone["position_rmse_mm"] != open_loop["position_rmse_mm"] and alone["position_rmse_mm"] < 2.0
+    assert "| ekf_perception |" in (tmp_path / "results.md").read_text()
     # The raw measurements are the testbed's motion capture: their RMSE is its noise.
     assert 0.5 < summary["raw"]["position_rmse_mm"] / (1e3 * math.sqrt(2) * REALISTIC.tracking_noise_xy) < 1.5
     # ekf_learned: the noise learned on other pushes (seed + 1) in the scale's steps, reported beside the hand-set.
@@ -48,7 +64,7 @@ def test_smoke_run_writes_the_tables_and_the_figure(tmp_path):
     assert len(pushes) == tracking.SCALES["smoke"]["pushes"]
     assert sum(push["dropped"] for push in pushes) > 0  # 20 % of the samples dropped: skipped, not zeros
     for push in pushes:
-        for name in tracking.FILTERS:
+        for name in (*tracking.FILTERS, *tracking.PERCEPTION_FILTERS):
             mu = np.asarray(push["filters"][name]["mu"])
             assert len(mu) == push["steps"] + 1 and np.all(np.isfinite(mu)) and np.all(mu > 0)
 
