@@ -20,7 +20,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import jax
 import jax.numpy as jnp
@@ -74,15 +74,22 @@ class FitResult:
     Attributes:
       effects: the effect names, in library order.
       params: {effect: {parameter: NumPy array}} in SI units (see :mod:`pushjax.physics.effects`).
-      physical: {effect: {value name: {"value": float, "std": float or None}}}, the reported values with
-        their standard errors (None where the value is not differentiable at the optimum).
       loss: final fit loss.
+      compute_physical: computes :attr:`physical` (the sandwich standard errors need the residual's Jacobian, and
+        most fits of forward selection, e.g. every fold's but the first, are never reported).
     """
 
     effects: tuple[str, ...]
     params: dict[str, dict[str, np.ndarray]]
-    physical: dict[str, dict[str, dict[str, float]]]
     loss: float
+    compute_physical: Callable[[], dict[str, dict[str, dict[str, float | None]]]] = dataclasses.field(
+        default=dict, repr=False, compare=False)
+
+    @functools.cached_property
+    def physical(self) -> dict[str, dict[str, dict[str, float | None]]]:
+        """{effect: {value name: {"value": float, "std": float or None}}}, the reported values with their standard
+        errors (None where the value is not differentiable at the optimum); computed on first use."""
+        return self.compute_physical()
 
 
 @dataclasses.dataclass(frozen=True)
@@ -301,8 +308,9 @@ def fit_effects(
                 effects=candidates[k],
                 params={name: {key: np.asarray(value) for key, value in params[name].items()}
                         for name in candidates[k]},
-                physical=_physical_with_std(one, masks[slot], batch, scales, floors, sequence, candidates[k], exact),
                 loss=float(losses[slot]),
+                compute_physical=functools.partial(_physical_with_std, one, masks[slot], batch, scales, floors,
+                                                   sequence, candidates[k], exact),
             )
     return results
 

@@ -21,7 +21,7 @@ TRUE = {"cof_offset": {"offset": np.array([0.008, -0.004])},
 def synthetic(record):
     """Examples whose targets follow cof_offset + friction_ratio, plus 0.2 mm / 0.2 deg noise."""
     examples, _ = build_examples(iter_pushes(record("clean")), stride=STRIDE)
-    truth = fit.FitResult(effects=tuple(TRUE), params=TRUE, physical={}, loss=0.0)
+    truth = fit.FitResult(effects=tuple(TRUE), params=TRUE, loss=0.0)
     target = fit.predict([truth], examples)[0]
     noise = np.random.default_rng(0).normal(size=target.shape) * np.array([2e-4, 2e-4, np.radians(0.2)])
     return dataclasses.replace(examples, target=target + noise)
@@ -92,7 +92,7 @@ def _two_surfaces(examples, scales):
     target = np.zeros_like(examples.target)
     for name, scale in scales.items():
         truth = fit.FitResult(effects=("pusher_friction",), params={"pusher_friction": {"log_scale": np.array(scale)}},
-                              physical={}, loss=0.0)
+                              loss=0.0)
         target[surface == name] = fit.predict([truth], examples)[0][surface == name]
     noise = np.random.default_rng(3).normal(size=target.shape) * np.array([2e-4, 2e-4, np.radians(0.2)])
     return dataclasses.replace(examples, target=target + noise,
