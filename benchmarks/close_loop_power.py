@@ -117,6 +117,7 @@ def analyse(data_dir: Path, setup: str, case: str, seed: int, cached_only: bool 
     decision = decide(examples, LoopSettings(), seed)
     model = decision.selection.model
     outcome = {"selected": decision.selection.selected,
+               "alternatives": decision.selection.alternatives,
                "params": model.physical if model is not None else {},
                "force_sensor": decision.force.as_dict(),
                "plain_score": metrics.combined(metrics.summarize(plain)),
@@ -156,6 +157,13 @@ def found(setup: str, case: str, outcome: dict) -> bool:
         return fitted is not None and np.sign(outwardness(fitted, SETUPS[setup][0]) - 1) == np.sign(injected)
     others = false_discoveries(outcome)
     return bool(others) and others[0] in RIGHT_FIRST[family]
+
+
+def _listing(outcome: dict) -> str:
+    """The selected effects, and in brackets those the data could not tell a selected one from (analyses stored
+    before the loop reported them have no brackets)."""
+    rivals = "; ".join(f"{name} or {' or '.join(others)}" for name, others in outcome.get("alternatives", {}).items())
+    return ("+".join(outcome["selected"]) or "-") + (f" (not decided: {rivals})" if rivals else "")
 
 
 def upper_bound(count: int, total: int, level: float = 0.95) -> float:
@@ -209,7 +217,7 @@ def main():
         results = outcomes[case]
         added = np.mean([outcome["plain_score"] for outcome in results]) / clean - 1
         beyond = np.mean([bool(false_discoveries(outcome)) for outcome in results])
-        listing = "; ".join("+".join(outcome["selected"]) or "-" for outcome in results)
+        listing = "; ".join(_listing(outcome) for outcome in results)
         power = None if case in CLEAN else np.mean([found(args.setup, case, outcome) for outcome in results])
         print(f"| {case} | {support} | {effects or '-'} | {start_poses} | "
               f"{np.mean([o['plain_score'] for o in results]):.1f} | "

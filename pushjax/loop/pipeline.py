@@ -260,6 +260,7 @@ def close_loop(
                                              select=report_lib.Errors.from_summary(c.summary))
                      for c in selection.ranking],
             selected=selection.selected,
+            alternatives=selection.alternatives,
             after=measured(model_test),
             noise_floor=metrics.noise_floor(test.target, test.sequence, test.push, test.window, test.tracking_noise,
                                             settings.n_bootstrap, seed),

@@ -115,6 +115,9 @@ class LoopReport:
       diagnosis: the plain model's residual on the pool against each variable, strongest first.
       ranking: the single-effect models, best selection score first.
       selected: the selected effects in the order they were selected.
+      alternatives: {selected effect: {rival: p-value}} the effects the select split cannot tell a selected one from
+        (they passed the same tests with a smaller gain that the selected one's does not exceed beyond noise); a
+        rival explains the data as well, so the selected effect's physics is not decided between them.
       after: the selected model's test errors.
       noise_floor: the test split's noise floor.
       pusher_friction: the pusher–object friction coefficient the models used.
@@ -132,6 +135,7 @@ class LoopReport:
     diagnosis: list[diagnose_lib.Dependence]
     ranking: list[RankedEffect]
     selected: list[str]
+    alternatives: dict[str, dict[str, float]]
     after: HeldOutErrors
     noise_floor: metrics.NoiseFloor
     pusher_friction: PusherFriction
@@ -159,6 +163,7 @@ class LoopReport:
             "diagnosis": _strengths(self.diagnosis),
             "ranking": [dataclasses.asdict(entry) for entry in self.ranking],
             "selected": self.selected,
+            "alternatives": self.alternatives,
             "after": dataclasses.asdict(self.after),
             "noise_floor": self.noise_floor.as_dict(),
             "pusher_friction": {**dataclasses.asdict(self.pusher_friction),
@@ -247,7 +252,7 @@ class LoopDetails:
                         "mechanism": [{**dataclasses.asdict(check), "p_value": check.p_value,
                                        "variable": check.variable, "knob": check.is_knob(self.alpha)}
                                       for check in r.mechanism],
-                        "accepted": r.accepted} for r in self.rounds],
+                        "accepted": r.accepted, "indistinguishable": r.indistinguishable} for r in self.rounds],
             "fallback_select": {"gain": self.fallback_gain, "p_value": self.fallback_p_value,
                                 "beyond_noise": self.fallback_beyond_noise},
             "selected_params": self.selected_params,
@@ -393,6 +398,20 @@ def _combined_rim(motion: dict, force: dict, alpha: float = 0.05) -> str:
             "times narrower than the motion's alone.")
 
 
+def _alternatives_lines(alternatives: dict[str, dict[str, float]]) -> list[str]:
+    """A paragraph naming the selected effects the data cannot tell from others, or nothing."""
+    if not alternatives:
+        return []
+    pairs = "; ".join(f"`{name}` from " + ", ".join(f"`{rival}` (p = {p:.2g})" for rival, p in rivals.items())
+                      for name, rivals in alternatives.items())
+    return [f"**Not decided by this data**: {pairs} (one-sided sign-flip p-value that the selected effect's gain "
+            "exceeds the other's). Each explains the select split about as well, so the physics behind the selected "
+            "effect is one of them. Pushes that vary what tells them apart separate them: a table-fixed effect "
+            "(`friction_field`, `table_tilt`) from an object-fixed one (`cof_offset`, `pressure_gradient`, "
+            "`limit_surface`) by start poses spread over the table (`python -m experiments.record_pushes "
+            "--start_poses=scattered` on the testbed), the others by more objects, surfaces or speeds.", ""]
+
+
 def _uncertainty_row(label: str, scores: dict) -> str:
     return (f"| {label} | {scores['nlpd']:.2f} | {scores['coverage_68']:.1%} | {scores['coverage_95']:.1%} | "
             f"{scores['calibrated_coverage_68']:.1%} | {scores['calibrated_coverage_95']:.1%} |")
@@ -425,6 +444,7 @@ def markdown(result: LoopResult) -> str:
         _metrics_row("selected: " + (" + ".join(report.selected) or "nothing"), report.after),
         _metrics_row("selected + learned error term", report.fallback),
         "",
+        *_alternatives_lines(report.alternatives),
         "## How sure the model is (test split)",
         "",
         "Negative log predictive density per window (translation in mm, rotation in deg) and the share of the "
@@ -486,6 +506,9 @@ def markdown(result: LoopResult) -> str:
                            f"between-group spread {worst.relative_spread:.2f} of the effect's size: "
                            + ("**a knob, not a mechanism**" if check.is_knob(details.alpha) else "a mechanism"))
             lines.append(f"   - mechanism check of `{check.effect}`: {verdict}")
+        if round_.indistinguishable:
+            lines.append("   - indistinguishable on the select split: " + ", ".join(
+                f"`{name}` (p = {p:.2g})" for name, p in round_.indistinguishable.items()))
     if report.selected:
         lines += ["", "Fitted parameters of the selected model (every pool push):", ""]
         lines += [f"- {name}: {_params_text(params)}" for name, params in details.selected_params.items()]

@@ -21,7 +21,10 @@ subsumes ``friction_ratio`` and ``pressure_gradient``, replaces them) and tests 
   weight: ``Effect.per_object``) are compared across surfaces and velocities only.
 
 Among the candidates that pass, the one with the largest gain is added; selection stops when none passes.
-The selected set is then refitted on the whole pool; the test split is never used here.
+The other candidates that passed the first two tests and whose gain the added one does not beat beyond noise (the
+same sign-flip test on the per-sequence difference, at ``alpha``) are its indistinguishable rivals: the data cannot
+tell the added effect from them (a table-fixed friction field and a moved centre of mass from one start pose), and
+the report names them. The selected set is then refitted on the whole pool; the test split is never used here.
 """
 
 from __future__ import annotations
@@ -144,6 +147,9 @@ class Round:
         error above the noise floor.
       mechanism: the mechanism checks made in this round, in the order of the candidates' gains.
       accepted: the effect added in this round, or None (selection stops).
+      indistinguishable: {effect: one-sided p-value that the accepted effect's gain exceeds its gain} of the other
+        candidates beyond noise and above the floor, with a smaller gain, that the accepted one does not beat at
+        ``alpha`` (empty when nothing was accepted).
     """
 
     candidates: list[Candidate]
@@ -155,6 +161,7 @@ class Round:
     floor: float
     mechanism: list[MechanismCheck]
     accepted: str | None
+    indistinguishable: dict[str, float]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -182,6 +189,13 @@ class Selection:
         """The final model's effects in the order they were selected (one replaced by a later one left out)."""
         accepted = [round_.accepted for round_ in self.rounds if round_.accepted is not None]
         return [name for name in accepted if name in self.final.effects]
+
+    @property
+    def alternatives(self) -> dict[str, dict[str, float]]:
+        """{selected effect: its indistinguishable rivals with their p-values}, for the selected effects that have
+        any."""
+        return {round_.accepted: round_.indistinguishable for round_ in self.rounds
+                if round_.accepted in self.final.effects and round_.indistinguishable}
 
 
 class _Folds:
@@ -260,7 +274,8 @@ def select_effects(
         rounds.append(Round(candidates=candidates, additions=additions, gains=gains,
                             p_values=[float(p) for p in p_values], levels=[float(level) for level in levels],
                             beyond_noise=[bool(b) for b in beyond_noise], floor=float(required), mechanism=checks,
-                            accepted=additions[best] if best is not None else None))
+                            accepted=additions[best] if best is not None else None,
+                            indistinguishable=_rivals(per_sequence, points, passing, best, additions, alpha, seed)))
         if best is None:
             break
         current = candidates[best]
@@ -310,6 +325,19 @@ def check_mechanism(pool: Examples, effects: tuple[str, ...], added: str, settin
                            relative_spread=relative)
              for p_value, variable, name, relative in sorted(raw, key=lambda test: test[0])]
     return MechanismCheck(effect=added, tests=tests, values=values)
+
+
+def _rivals(per_sequence: np.ndarray, points: np.ndarray, passing: np.ndarray, best: int | None,
+            additions: Sequence[str], alpha: float, seed: int) -> dict[str, float]:
+    """{addition: p-value} of the passing candidates with a smaller gain than ``best`` whose per-sequence gains
+    [S] ``best``'s do not exceed beyond noise (one-sided sign-flip test of the difference at ``alpha``)."""
+    if best is None:
+        return {}
+    smaller = [int(index) for index in passing if index != best and points[index] <= points[best]]
+    if not smaller:
+        return {}
+    p_values = metrics.sign_flip_pvalues(per_sequence[best] - per_sequence[smaller], seed=seed)
+    return {additions[index]: float(p) for index, p in zip(smaller, p_values) if p > alpha}
 
 
 def _unit(name: str) -> str:

@@ -4,7 +4,8 @@
 markdown code from before the results were typed (which read the two JSON files' dicts back by key), and the JSON files
 had the keys, in order, of the files that code's loop wrote: the typed results changed no key and no byte. Since then
 the files gained the per-group values (``per_group``), the calibrated coverages and the limit surface's shape from the
-force sensor (``limit_surface_shape``), and nothing else.
+force sensor (``limit_surface_shape``), the effects the data cannot tell a selected one from (``alternatives``),
+and nothing else.
 """
 
 import dataclasses
@@ -49,15 +50,16 @@ def small_result(measured_friction: bool) -> report_lib.LoopResult:
                                                                      "rot_percent": [6.5, 8.5]},
                        source="tracking", n_windows=300)
     rounds = [
-        Round(candidates=[], additions=["cof_offset", "table_tilt"], gains=[0.375, 0.0625], p_values=[0.0001, 0.25],
-              levels=[0.025, 0.05], beyond_noise=[True, False], floor=1.5,
+        Round(candidates=[], additions=["cof_offset", "table_tilt", "friction_field"], gains=[0.375, 0.0625, 0.3125],
+              p_values=[0.0001, 0.25, 0.0002], levels=[0.0166, 0.05, 0.025], beyond_noise=[True, False, True],
+              floor=1.5,
               mechanism=[MechanismCheck("cof_offset", [Heterogeneity("surface", "offset_x_mm", 0.5, 0.75)], {}),
                          MechanismCheck("cof_offset", [Heterogeneity("object", "offset_y_mm", 0.01, 0.625),
                                                        Heterogeneity("surface", "offset_x_mm", 0.5, 0.25)], {}),
                          MechanismCheck("cof_offset", [], {})],
-              accepted="cof_offset"),
+              accepted="cof_offset", indistinguishable={"friction_field": 0.125}),
         Round(candidates=[], additions=["table_tilt"], gains=[-0.125], p_values=[0.75], levels=[0.05],
-              beyond_noise=[False], floor=0.75, mechanism=[], accepted=None),
+              beyond_noise=[False], floor=0.75, mechanism=[], accepted=None, indistinguishable={}),
     ]
     report = report_lib.LoopReport(
         n_pushes={"fit": 60, "select": 90, "test": 30, "skipped": 2},
@@ -66,6 +68,7 @@ def small_result(measured_friction: bool) -> report_lib.LoopResult:
         ranking=[report_lib.RankedEffect("cof_offset", offset, report_lib.Errors(10.0, 12.5, 0.75, 0.375)),
                  report_lib.RankedEffect("table_tilt", tilt, report_lib.Errors(19.5, 29.0, 1.5, 0.75))],
         selected=["cof_offset"],
+        alternatives={"cof_offset": {"friction_field": 0.125}} if measured_friction else {},
         after=_errors(0.5 if measured_friction else 0.25),  # explained without the measurement
         noise_floor=floor,
         pusher_friction=report_lib.PusherFriction(nominal=0.25, force_sensor=force,

@@ -49,9 +49,11 @@ def test_pusher_friction_is_measured_by_the_force_sensor_not_fitted(name, loop_r
 def test_report_follows_the_schema(loop_report):
     report, workdir = loop_report("com_offset_and_pusher_friction")
     assert json.loads((workdir / "report.json").read_text()) == report
-    assert set(report) == {"n_pushes", "baseline", "diagnosis", "ranking", "selected", "after", "noise_floor",
-                           "pusher_friction", "explained", "fallback", "remaining", "uncertainty", "per_group",
-                           "limit_surface_shape"}
+    assert set(report) == {"n_pushes", "baseline", "diagnosis", "ranking", "selected", "alternatives", "after",
+                           "noise_floor", "pusher_friction", "explained", "fallback", "remaining", "uncertainty",
+                           "per_group", "limit_surface_shape"}
+    assert set(report["alternatives"]) <= set(report["selected"])
+    assert all(0.05 < p <= 1 for rivals in report["alternatives"].values() for p in rivals.values())
     assert report["per_group"] == []  # one object on one surface: no groups to fit apart
     friction = report["pusher_friction"]
     assert set(friction) == {"nominal", "force_sensor", "from_force_sensor", "used"}
