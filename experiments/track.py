@@ -78,6 +78,9 @@ def main(argv):
     learns = "ekf_learned" in _FILTERS.value
     if _LEARN_STEPS.value is not None and not learns:
         raise app.UsageError("--learn_steps: only used by ekf_learned, which --filters leaves out")
+    for name in ("perception_hz", "perception_scale"):
+        if flags.FLAGS[name].present and _PERCEPTION.value is None:
+            raise app.UsageError(f"--{name}: only used with --perception, which is not given")
     every = rate / _PERCEPTION_HZ.value
     if _PERCEPTION.value is not None and not (_PERCEPTION_HZ.value > 0 and abs(every - round(every)) < 1e-9):
         raise app.UsageError(f"--perception_hz: expected the filter rate {rate:g} Hz divided by a whole number, got "

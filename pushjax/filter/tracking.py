@@ -420,7 +420,9 @@ def _perception_lines(results: dict) -> list[str]:
     std = ", ".join(f"{1e3 * value:.2f}" for value in info["std"])
     return ["", f"perception: {info['model']} at {info['rate_hz']:g} Hz; the position row `perception` is its readings "
             f"of the centre of mass against the truth (no yaw); reading noise (x, y) {std} mm, "
-            f"{info['noise_estimated_on']}."]
+            f"{info['noise_estimated_on']}."
+            + (f" {info['scenes']} scenes rendered and located in {info['seconds_with_compile']:.1f} s with compilation."
+               if "scenes" in info else "")]
 
 
 def _figure(results: dict, path: Path, pushes: int = 4) -> None:

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import time
 from collections.abc import Sequence
 
 import numpy as np
@@ -146,12 +147,17 @@ def stream(sensor: PerceptionSensor, pushes: Sequence[TrackedPush], noise_pushes
     at `rate_hz`, the sensor at `rate_hz / every`."""
     if any(np.array_equal(held_out.truth, evaluated.truth) for held_out in noise_pushes for evaluated in pushes):
         raise ValueError("noise_pushes: the noise must be estimated on other pushes than the evaluated ones")
+    start = time.perf_counter()
     noise = estimate_noise(sensor, noise_pushes, every)
+    positions = readings(sensor, pushes, every)
+    seconds = time.perf_counter() - start
     seed = "" if noise_seed is None else f" simulated with seed {noise_seed}"
+    count = noise["readings"] + sum(int(np.isfinite(found[:, 0]).sum()) for found in positions.values())
     details = {"model": sensor.description, "rate_hz": rate_hz / every, "every_steps": every,
+               "seconds_with_compile": seconds, "scenes": count,
                "noise_bias": noise["bias"], "noise_rmse": noise["rmse"], "noise_readings": noise["readings"],
                "noise_estimated_on": (f"the RMS error per axis of {noise['readings']} readings of {noise['pushes']} "
                                       f"other pushes{seed} (bias included: "
                                       f"{', '.join(f'{1e3 * b:+.2f}' for b in noise['bias'])} mm)")}
-    return PositionStream(positions=readings(sensor, pushes, every),
+    return PositionStream(positions=positions,
                           std=tuple(max(value, 1e-5) for value in noise["std"]), details=details)
