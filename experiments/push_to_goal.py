@@ -5,9 +5,18 @@ r"""Push objects to goal poses with model-predictive control, closed on the MuJo
       [--loop_model=W/model.json]
       [--planners=gradient,sampling] [--seed=0] [--surface=abs] [--testbed=realistic|ideal]
       [--testbed_overrides='drop_rate=0'] [--effects='table_tilt_deg=2'] [--max_time=60]
+      [--states=mocap,mocap+perception,perception --perception=<a trained model's work directory or checkpoint>
+       [--perception_scale=cpu] [--perception_every=1]]
 
 Draws the goals (``pushjax.control.goals``), runs every model and planner on each (``pushjax.control.push_to_goal``,
 resumable from ``--workdir``/episodes.jsonl) and writes ``results.json``, ``results.md`` and ``trajectories.png``.
+
+``--states`` chooses where the controller's state comes from (``pushjax.control.closed_loop.STATE_SOURCES``): motion
+capture, motion capture and perception, perception only. Perception is the ``--perception`` model's (a hybrid trained
+on the ``data_efficiency`` dataset at ``--perception_scale``): the centre of mass it locates in the depth image of the
+true scene, rendered as its dataset renders examples, every ``--perception_every`` control periods
+(``pushjax.sensing.perception``); its noise is estimated on one push per object simulated with seed ``--seed`` + 1
+(``pushjax.filter.tracking.simulate_pushes``), not on the evaluated episodes.
 """
 
 import math
@@ -16,7 +25,10 @@ from absl import app, flags
 
 import experiments
 from pushjax.control import closed_loop, mpc, push_to_goal, report
+from pushjax.data import configs as data_configs
+from pushjax.filter import tracking
 from pushjax.geometry.objects import OBJECT_NAMES
+from pushjax.sensing import perception
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
 
@@ -36,7 +48,19 @@ _TESTBED = experiments.define_testbed_flag()
 _TESTBED_OVERRIDES = flags.DEFINE_string("testbed_overrides", "", "Testbed magnitudes to change, e.g. 'drop_rate=0'.")
 _EFFECTS = flags.DEFINE_string("effects", "", "Effects of the simulated world, e.g. 'table_tilt_deg=2'.")
 _MAX_TIME = flags.DEFINE_float("max_time", None, "Simulated seconds per goal (default: the scale's).", lower_bound=1)
+_STATES = flags.DEFINE_list("states", ["mocap"], "The controller's state sources from "
+                            f"{','.join(closed_loop.STATE_SOURCES)} (perception: needs --perception).")
+_PERCEPTION = flags.DEFINE_string("perception", None, "A trained model's work directory or checkpoint "
+                                  "(pushjax.train.predictor.load_model; its last model) whose perception reads the "
+                                  "object's position from the rendered depth image.")
+_PERCEPTION_SCALE = flags.DEFINE_enum("perception_scale", "cpu", list(data_configs.SCALES),
+                                      "Scale of the data_efficiency dataset the --perception model was trained on (its "
+                                      "camera and image size render the scenes).")
+_PERCEPTION_EVERY = flags.DEFINE_integer("perception_every", 1, "Control periods between perception readings.",
+                                         lower_bound=1)
 experiments.require_writable_folder("workdir")
+NOISE_PUSHES = 1
+"""Pushes per object, simulated with seed --seed + 1, on which the perception's noise is estimated."""
 
 
 @flags.validator("max_time", "expected a finite number of seconds >= 1")
@@ -78,6 +102,13 @@ flags.register_multi_flags_validator(
     ["models", "loop_model"], lambda values: (push_to_goal.LOOP_MODEL in values["models"]) == bool(values["loop_model"]),
     f"--loop_model: expected exactly when --models has '{push_to_goal.LOOP_MODEL}'")
 flags.register_validator("effect_params", _parsed_by(push_to_goal.parse_effect_params))
+flags.register_validator(
+    "states", lambda values: bool(values) and len(set(values)) == len(values)
+    and set(values) <= set(closed_loop.STATE_SOURCES),
+    f"expected a non-empty list from {','.join(closed_loop.STATE_SOURCES)}, no repeats")
+flags.register_multi_flags_validator(
+    ["states", "perception"], lambda values: any("perception" in state for state in values["states"])
+    == bool(values["perception"]), "--perception: expected exactly when --states has a state with perception")
 flags.register_validator("effects", _parsed_by(Effects.parse))
 
 
@@ -88,10 +119,30 @@ def main(argv):
     scale = push_to_goal.SCALES[_SCALE.value]
     loop = closed_loop.LoopConfig(max_time=_MAX_TIME.value or scale["max_time"], surface=_SURFACE.value,
                                   testbed=testbed, effects=Effects.parse(_EFFECTS.value))
+    objects = _OBJECTS.value or scale["objects"]
+    for name in ("perception_scale", "perception_every"):
+        if flags.FLAGS[name].present and _PERCEPTION.value is None:
+            raise app.UsageError(f"--{name}: only used with --perception, which is not given")
+    position, position_settings = None, None
+    if _PERCEPTION.value is not None:
+        try:
+            sensor = perception.load(_PERCEPTION.value, data_configs.get_config("data_efficiency",
+                                                                                _PERCEPTION_SCALE.value))
+        except ValueError as error:
+            raise app.UsageError(f"--perception: {' '.join(str(error).split())}") from None
+        period = scale["controller"].period
+        noise_seed = _SEED.value + tracking.TRAINING_SEED_OFFSET
+        noise_pushes = tracking.simulate_pushes(objects, NOISE_PUSHES, noise_seed, testbed, 1.0 / period)
+        noise = perception.estimate_noise(sensor, noise_pushes, _PERCEPTION_EVERY.value)
+        position = closed_loop.PositionSource(sensor.locate, tuple(max(v, 1e-5) for v in noise["std"]),
+                                              _PERCEPTION_EVERY.value, sensor.description)
+        position_settings = {"model": _PERCEPTION.value, "dataset": f"data_efficiency/{_PERCEPTION_SCALE.value}",
+                             "noise_seed": noise_seed, "noise_bias_m": noise["bias"], "noise_rmse_m": noise["rmse"],
+                             "noise_readings": noise["readings"], "noise_pushes": noise["pushes"]}
     try:
-        results = push_to_goal.run(_WORKDIR.value, _OBJECTS.value or scale["objects"],
-                                   _GOALS.value or scale["goals"], _MODELS.value, _PLANNERS.value or scale["planners"],
-                                   _SEED.value, loop, _EFFECT_PARAMS.value, scale["controller"], _LOOP_MODEL.value)
+        results = push_to_goal.run(_WORKDIR.value, objects, _GOALS.value or scale["goals"], _MODELS.value,
+                                   _PLANNERS.value or scale["planners"], _SEED.value, loop, _EFFECT_PARAMS.value,
+                                   scale["controller"], _LOOP_MODEL.value, _STATES.value, position, position_settings)
     except push_to_goal.ModelFileError as error:
         raise app.UsageError(f"--loop_model: {error}") from None
     results["settings"]["scale"] = _SCALE.value

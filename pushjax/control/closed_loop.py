@@ -8,7 +8,13 @@ One :func:`run_episode` is one goal: the object rests at its start pose, the pus
 1. filters the motion capture of the periods since the last plan (the testbed's noise, jitter and drops in the
    realistic profile; a dropped sample is NaN and only predicted) with the extended Kalman filter of
    :mod:`pushjax.filter.ekf`, whose process model is the same rollout step, one step per control period (process
-   noise: :data:`pushjax.filter.tracking.PROCESS_STD_PER_S`, tuned there on testbed pushes);
+   noise: :data:`pushjax.filter.tracking.PROCESS_STD_PER_S`, tuned there on testbed pushes); with a
+   :class:`PositionSource` (e.g. a trained model's perception of the rendered depth image, made at layer 6 by
+   ``pushjax.sensing.perception``) its reading of the true scene at the end of every ``every``-th control period
+   follows the pose update (:func:`pushjax.filter.models.update_position`, the source's own noise); without motion
+   capture (``motion_capture=False``: perception only) the readings are the only observation, the first one and the
+   start pose's orientation (the object was placed there) start the filter, and the orientation is only predicted
+   and inferred from how the position moves;
 2. asks :func:`pushjax.control.mpc.replan` with the filtered pose and the commanded pusher position;
 3. has the testbed (:class:`pushjax.sim.push.Episode`: the testbed's scene, stepping and testbed draws) move the
    pusher through the plan's first steps, or along the detour of a reposition, at the 4 ms recording clock.
@@ -26,6 +32,7 @@ import dataclasses
 import math
 import time
 import zlib
+from collections.abc import Callable
 
 import jax
 import jax.numpy as jnp
@@ -39,7 +46,12 @@ from pushjax.sim import push, scene
 from pushjax.sim.effects import Effects
 from pushjax.sim.testbed import REALISTIC, Testbed, draw_conditions
 
-__all__ = ["EpisodeResult", "LoopConfig", "filter_period", "run_episode", "waypoint_targets"]
+__all__ = ["EpisodeResult", "LoopConfig", "PositionSource", "STATE_SOURCES", "filter_period", "run_episode",
+           "waypoint_targets"]
+
+STATE_SOURCES = ("mocap", "mocap+perception", "perception")
+"""Where the filter's observations come from: motion capture alone, motion capture and a :class:`PositionSource`,
+the position source alone."""
 
 PRIOR_STD = (1e-3, 1e-3, 0.02, 0.3, 0.3)
 """Prior standard deviations of the filter at the first measurement (x m, y m, yaw rad, log mu, log l)."""
@@ -71,6 +83,30 @@ class LoopConfig:
 
 
 @dataclasses.dataclass(frozen=True)
+class PositionSource:
+    """A second sensor of the loop: the object's centre of mass read from the true scene (e.g. a trained model's
+    perception of its rendered depth image, :meth:`pushjax.sensing.perception.PerceptionSensor.locate`).
+
+    Attributes:
+      locate: ``locate(obj, poses [N, 3], pushers [N, 2]) -> [N, 2]``: the centre of mass (world x, y, m) read in the
+        scenes of `obj` at the true poses (x m, y m, yaw rad) with the pusher tip at `pushers` (m); deterministic.
+      std: [2] standard deviation of a reading, world x and y, m (> 0; estimated on other pushes than the evaluated).
+      every: control periods between readings (a reading at the end of every `every`-th period).
+      description: the sensor in words (for the report).
+    """
+
+    locate: Callable[[str, np.ndarray, np.ndarray], np.ndarray]
+    std: tuple[float, float]
+    every: int = 1
+    description: str = ""
+
+    def __post_init__(self):
+        if self.every < 1:
+            raise ValueError(f"every: expected a whole number of control periods >= 1, got {self.every}")
+        models.make_position_sensor("rect1", self.std)  # checks std
+
+
+@dataclasses.dataclass(frozen=True)
 class EpisodeResult:
     """One episode.
 
@@ -87,6 +123,7 @@ class EpisodeResult:
       poses: [N, 4] true poses (t s, x m, y m, yaw rad) at the control periods' ends.
       pusher: [N, 3] pusher tip (t s, x m, y m) at the same times.
       estimates: [P, 3] filtered poses the plans started from.
+      readings: [R, 3] the position source's readings (t s, x m, y m; centre of mass); [0, 3] without one.
     """
 
     final_pose: np.ndarray
@@ -101,6 +138,7 @@ class EpisodeResult:
     poses: np.ndarray
     pusher: np.ndarray
     estimates: np.ndarray
+    readings: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((0, 3)))
 
 
 @jax.jit
@@ -108,6 +146,10 @@ def filter_period(system: models.System, mean, cov, pusher, increment, measureme
     """(mean [5], cov [5, 5]) after predicting through one control period, the pusher moving from `pusher` [2] by
     `increment` [2] (world, m), and updating with `measurement` [3] (x m, y m, yaw rad; NaN: dropped)."""
     return models.update_linear(system, *ekf.predict(system, mean, cov, pusher, increment), measurement)
+
+
+position_update = jax.jit(models.update_position)
+"""(mean [5], cov [5, 5]) after a position reading (:func:`pushjax.filter.models.update_position`), compiled."""
 
 
 def waypoint_targets(start, waypoints, step: float, multiple: int) -> np.ndarray:
@@ -134,7 +176,8 @@ def _measured(piece: push.Recording, sample_indices: np.ndarray) -> np.ndarray:
 
 
 def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start, goal, *, seed: int, index: int = 0,
-                loop: LoopConfig = LoopConfig()) -> EpisodeResult:
+                loop: LoopConfig = LoopConfig(), position: PositionSource | None = None,
+                motion_capture: bool = True) -> EpisodeResult:
     """Pushes `obj` from `start` [3] to `goal` [3] (x m, y m, yaw rad) on the testbed of `loop`; see the module
     docstring.
 
@@ -147,7 +190,14 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
       seed: seed of the testbed's draws and the controller's key.
       index: the goal's index (part of the draws' entropy).
       loop: the :class:`LoopConfig`.
+      position: a :class:`PositionSource` whose readings follow the motion capture's (None: motion capture only).
+      motion_capture: False: the filter observes only `position`'s readings (perception only).
+
+    Raises:
+      ValueError: `motion_capture` False without a `position` source.
     """
+    if not motion_capture and position is None:
+        raise ValueError("position: without motion capture the loop needs a position source")
     began = time.perf_counter()
     start = np.asarray(start, np.float64)
     goal = np.asarray(goal, np.float64)
@@ -170,11 +220,15 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
     state = mpc.init(config, jax.random.fold_in(jax.random.key(seed), index))
     goal_array = jnp.asarray(goal, jnp.float32)
 
-    poses, tips = [], []
+    sensor = None if position is None else models.make_position_sensor(model.shape, position.std)
+    poses, tips, readings = [], [], []
     path_length = 0.0
+    periods = 0
 
-    def execute(targets):
-        nonlocal path_length
+    def execute(targets, read: bool = True):
+        """Moves the pusher through `targets`; returns its positions [n, 2] at the n control periods' ends, their
+        motion-capture poses [n, 3] (NaN: dropped or no motion capture) and the position readings [n, 2] (NaN: none)."""
+        nonlocal path_length, periods
         path_length += float(np.linalg.norm(np.diff(np.concatenate([episode.pusher[None], targets]), axis=0),
                                             axis=1).sum())
         first_sample = episode.samples
@@ -182,14 +236,33 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
         ends = np.arange(samples_per_period - 1, len(targets), samples_per_period)
         poses.append(piece.true_object_pose[ends])
         tips.append(piece.tip_pose[ends, :3])
-        return piece.tip_pose[ends, 1:3], _measured(piece, first_sample + 1 + ends)
+        measured = _measured(piece, first_sample + 1 + ends)
+        if not motion_capture:
+            measured[:] = np.nan
+        found = np.full((len(ends), 2), np.nan)
+        if position is not None and read:
+            rows = np.flatnonzero((periods + 1 + np.arange(len(ends))) % position.every == 0)
+            if len(rows):
+                found[rows] = position.locate(obj, piece.true_object_pose[ends[rows], 1:], piece.tip_pose[ends[rows], 1:3])
+                readings.append(np.concatenate([piece.true_object_pose[ends[rows], :1], found[rows]], axis=1))
+        periods += len(ends)
+        return piece.tip_pose[ends, 1:3], measured, found
 
     still = np.repeat(pusher[None], samples_per_period, axis=0)
-    observed = execute(still)[1][-1]
-    while not np.all(np.isfinite(observed)):  # the first measurement was dropped: wait for one
+    if motion_capture:
         observed = execute(still)[1][-1]
+        while not np.all(np.isfinite(observed)):  # the first measurement was dropped: wait for one
+            observed = execute(still)[1][-1]
+        prior_std = np.asarray(PRIOR_STD)
+    else:  # the first reading locates the centre of mass; the orientation is the start pose's, where it was placed
+        found = execute(still)[2][-1]
+        while not np.all(np.isfinite(found)):
+            found = execute(still)[2][-1]
+        observed = np.concatenate([found - np.asarray(contact.rotate(model.shape.centroid, start[2]), np.float64),
+                                   start[2:3]])
+        prior_std = np.concatenate([position.std, PRIOR_STD[2:]])
     mean = jnp.asarray(np.concatenate([observed, [0.0, 0.0]]), jnp.float32)
-    cov = jnp.diag(jnp.asarray(PRIOR_STD, jnp.float32) ** 2)
+    cov = jnp.diag(jnp.asarray(prior_std, jnp.float32) ** 2)
     estimates, plans, repositions, idle, stop = [], 0, 0, 0, "timeout"
     while episode.time < loop.max_time:
         estimate = np.asarray(mean[:3], np.float64)
@@ -217,15 +290,20 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
             fractions = np.arange(1, samples_per_period + 1)[None, :, None] / samples_per_period
             starts = commanded + np.concatenate([np.zeros((1, 2)), np.cumsum(steps, axis=0)[:-1]])
             targets = (starts[:, None] + fractions * steps[:, None]).reshape(-1, 2)
-        tip_path, measurements = execute(targets)
+        tip_path, measurements, found = execute(targets)
         path = np.concatenate([commanded[None], tip_path]).astype(np.float32)
-        for begin, end, measurement in zip(path[:-1], path[1:], measurements.astype(np.float32)):
+        for begin, end, measurement, reading in zip(path[:-1], path[1:], measurements.astype(np.float32),
+                                                    found.astype(np.float32)):
             mean, cov = filter_period(system, mean, cov, begin, end - begin, measurement)
-    execute(np.repeat(episode.pusher[None], max(1, round(loop.settle / config.period)) * samples_per_period, axis=0))
+            if np.all(np.isfinite(reading)):
+                mean, cov = position_update(sensor, mean, cov, reading)
+    execute(np.repeat(episode.pusher[None], max(1, round(loop.settle / config.period)) * samples_per_period, axis=0),
+            read=False)
     poses, tips = np.concatenate(poses), np.concatenate(tips)
     final = poses[-1, 1:]
     return EpisodeResult(
         final_pose=final, position_error=float(np.hypot(*(final[:2] - goal[:2]))),
         yaw_error=float(wrap(final[2] - goal[2])), path_length=path_length, time=episode.time,
         wall_time=time.perf_counter() - began, plans=plans, repositions=repositions, stop=stop, poses=poses,
-        pusher=tips, estimates=np.asarray(estimates).reshape(-1, 3))
+        pusher=tips, estimates=np.asarray(estimates).reshape(-1, 3),
+        readings=np.concatenate(readings) if readings else np.zeros((0, 3)))

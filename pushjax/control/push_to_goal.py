@@ -6,7 +6,14 @@ Models are named ``lynch`` (plain Lynch) or ``lynch+<effect>+...`` (Lynch with e
 (:func:`parse_effect_params`; unset parameters keep their "no effect" values), planning with the testbed's nominal
 pusher friction; or ``loop``: the model in a pushing model file (:mod:`pushjax.physics.model_file`, e.g. the
 ``model.json`` that ``experiments.close_loop`` selected), with its effects, parameters and pusher friction. Every
-model plans with the uniform-pressure limit-surface ratio. Episodes are appended to
+model plans with the uniform-pressure limit-surface ratio.
+
+Each model runs with each state source of :data:`pushjax.control.closed_loop.STATE_SOURCES`: ``mocap`` (motion capture
+through the EKF), ``mocap+perception`` (and a :class:`~pushjax.control.closed_loop.PositionSource`'s readings, e.g. a
+trained hybrid's perception of the rendered depth image, wired at layer 6/7 by ``experiments.push_to_goal``),
+``perception`` (the readings alone). With the default, motion capture alone, rows are named by the model; otherwise
+by the model and its state source, e.g. ``lynch (mocap + perception)`` (:func:`label`), so that
+:func:`pushjax.control.report.compare` pairs them on the same goals. Episodes are appended to
 ``episodes.jsonl`` in the work folder as they finish, keyed by the run's settings, so an interrupted run resumes
 where it stopped; :mod:`pushjax.control.report` turns the rows into ``results.json``, a table and a figure.
 """
@@ -29,7 +36,7 @@ from pushjax.physics import effects as effects_lib
 from pushjax.physics import model_file
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
 
-__all__ = ["LOOP_MODEL", "SCALES", "ModelFileError", "model_effects", "parse_effect_params", "run"]
+__all__ = ["LOOP_MODEL", "SCALES", "ModelFileError", "label", "model_effects", "parse_effect_params", "run"]
 
 SCALES = {
     "smoke": {"objects": ("rect1",), "goals": 2, "planners": ("gradient",), "max_time": 30.0,
@@ -100,13 +107,21 @@ def parse_effect_params(spec: str) -> dict[str, dict[str, np.ndarray]]:
     return params
 
 
+def label(model: str, state: str, states: Sequence[str]) -> str:
+    """The rows' name of `model` with the state source `state`: the model's name when `states` is motion capture alone
+    (the default), else ``model (state)`` with spaces around a ``+``, e.g. ``lynch (mocap + perception)``."""
+    return model if tuple(states) == ("mocap",) else f"{model} ({state.replace('+', ' + ')})"
+
+
 def _fingerprint(settings: dict) -> str:
     return hashlib.sha256(json.dumps(settings, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
 def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, models: Sequence[str],
         planners: Sequence[str], seed: int, loop: closed_loop.LoopConfig, effect_params: str = "",
-        controller: mpc.ControllerConfig = mpc.ControllerConfig(), loop_model: str | Path | None = None) -> dict:
+        controller: mpc.ControllerConfig = mpc.ControllerConfig(), loop_model: str | Path | None = None,
+        states: Sequence[str] = ("mocap",), position: closed_loop.PositionSource | None = None,
+        position_settings: dict | None = None) -> dict:
     """Runs every model and planner on every goal (resuming from ``workdir/episodes.jsonl``); returns the
     results of :func:`pushjax.control.report.summarise`.
 
@@ -121,11 +136,22 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
       effect_params: the models' effect parameters (:func:`parse_effect_params`).
       controller: the controller's settings (``planner`` replaced by each of `planners`).
       loop_model: the pushing model file of the ``loop`` model (needed when `models` has it).
+      states: state sources from :data:`pushjax.control.closed_loop.STATE_SOURCES`, no repeats.
+      position: the position source of the states with ``perception`` (needed when `states` has one).
+      position_settings: what identifies `position` in the results' settings and the episodes' fingerprint (e.g. the
+        trained model, its dataset and the noise estimate; JSON-able).
 
     Raises:
-      ValueError: ``loop`` among `models` without `loop_model`; ModelFileError (a ValueError): a bad model file;
-        one line.
+      ValueError: ``loop`` among `models` without `loop_model`, an unknown or repeated state source, or one with
+        perception without `position`; ModelFileError (a ValueError): a bad model file; one line.
     """
+    states = tuple(states)
+    if not states or len(set(states)) != len(states) or not set(states) <= set(closed_loop.STATE_SOURCES):
+        raise ValueError(f"states: expected a non-empty list from {','.join(closed_loop.STATE_SOURCES)}, no repeats, "
+                         f"got {','.join(states)}")
+    perceives = any("perception" in state for state in states)
+    if perceives and position is None:
+        raise ValueError("position: the state sources with perception need a position source")
     params = parse_effect_params(effect_params)
     specs = {}
     for name in models:
@@ -144,6 +170,11 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
                 "controller": repr(controller)}
     if LOOP_MODEL in models:
         settings["loop_model"] = specs[LOOP_MODEL].as_dict()
+    if states != ("mocap",):  # the default keeps the fingerprints of the runs before state sources
+        settings["states"] = list(states)
+    if perceives:
+        settings["position"] = {"description": position.description, "std_m": list(position.std),
+                                "every_periods": position.every, **(position_settings or {})}
     fingerprint = _fingerprint(settings)
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
@@ -155,10 +186,11 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
             if row["fingerprint"] == fingerprint:
                 done[(row["model"], row["planner"], row["object"], row["index"])] = row
     rows = []
-    jobs = [(name, planner, task) for name in models for planner in planners for task in tasks]
+    jobs = [(name, state, planner, task) for name in models for state in states for planner in planners
+            for task in tasks]
     with log.open("a") as out:
-        for name, planner, task in tqdm.tqdm(jobs, desc="push_to_goal", unit="goal"):
-            key = (name, planner, task.obj, task.index)
+        for name, state, planner, task in tqdm.tqdm(jobs, desc="push_to_goal", unit="goal"):
+            key = (label(name, state, states), planner, task.obj, task.index)
             if key in done:
                 rows.append(done[key])
                 continue
@@ -166,9 +198,12 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
             model = make_model(task.obj, mu=spec.mu, effects=spec.effects, params=spec.params)
             config = dataclasses.replace(controller, planner=planner)
             result = closed_loop.run_episode(model, config, task.obj, task.start, task.goal, seed=seed,
-                                             index=task.index, loop=loop)
-            row = {"fingerprint": fingerprint, "model": name, "planner": planner, "object": task.obj,
-                   "index": task.index, **report.episode_row(task, result, TRAJECTORY_STRIDE)}
+                                             index=task.index, loop=loop,
+                                             position=position if "perception" in state else None,
+                                             motion_capture="mocap" in state)
+            row = {"fingerprint": fingerprint, "model": key[0], "planner": planner, "object": task.obj,
+                   "index": task.index, **({} if states == ("mocap",) else {"model_name": name, "state": state}),
+                   **report.episode_row(task, result, TRAJECTORY_STRIDE)}
             out.write(json.dumps(row) + "\n")
             out.flush()
             rows.append(row)

@@ -120,7 +120,13 @@ def table(results: dict) -> str:
     header = ("| {} | successes | success rate [Wilson 95 %] | median position error (mm) | median orientation error "
               "(deg) | mean pusher path (m) | mean time (s) | mean wall time (s) |\n|---|---:|---:|---:|---:|---:|---:|---:|")
     lines = [f"Success: final position error < {criterion['position_mm']:g} mm and orientation error < "
-             f"{criterion['yaw_deg']:g} deg.", "", header.format("model / planner")]
+             f"{criterion['yaw_deg']:g} deg.", ""]
+    position = results["settings"].get("position")
+    if position:
+        noise = ", ".join(f"{1e3 * value:.2f}" for value in position["std_m"])
+        lines += [f"State sources: {', '.join(results['settings']['states'])}; perception: {position['description']}, "
+                  f"a reading every {position['every_periods']} control period(s), noise std {noise} mm (x, y).", ""]
+    lines += [header.format("model / planner")]
     lines += [_line(name, entry) for name, entry in results["summary"].items()]
     if results.get("comparisons"):
         lines += ["", (f"Comparisons (paired over goals; better: the mean difference of the time to success, a failure "

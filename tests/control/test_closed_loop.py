@@ -1,12 +1,18 @@
 """The controller closed on the MuJoCo testbed: a near goal reached under the realistic profile, the same seed giving
-the same run; waypoints resampled at the speed limit."""
+the same run; waypoints resampled at the speed limit; the state from a trained hybrid's perception of the depth
+image instead of motion capture."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+from pushjax import planar
 from pushjax.control import closed_loop, goals, model, push_to_goal
+from pushjax.data import configs as data_configs
+from pushjax.geometry.objects import get_object
+from pushjax.sensing import perception
 from pushjax.sim.testbed import REALISTIC
 
 CONFIG = push_to_goal.SCALES["smoke"]["controller"]
@@ -46,3 +52,46 @@ def test_the_same_seed_gives_the_same_run(episodes):
     first, second = episodes
     np.testing.assert_array_equal(first.poses, second.poses)
     np.testing.assert_array_equal(first.estimates, second.estimates)
+
+
+PERCEPTION_MODEL = Path(__file__).resolve().parents[2] / "results" / "track_perception" / "model"
+"""The committed hybrid (``experiments.data_efficiency_full``'s, cpu_full data) that ``tests/filter/test_track.py``
+also reads: a real trained network, read only."""
+
+
+@pytest.fixture(scope="module")
+def perceived():
+    """A short episode twice with the state from the hybrid's perception of the rendered depth image alone (no motion
+    capture), a reading every other control period, the noise of RESULTS.md's perception readings (0.5 mm)."""
+    sensor = perception.load(PERCEPTION_MODEL, data_configs.get_config("data_efficiency", "cpu_full"))
+    source = closed_loop.PositionSource(sensor.locate, (5e-4, 5e-4), every=2, description=sensor.description)
+    loop = closed_loop.LoopConfig(max_time=3.0)
+    return [closed_loop.run_episode(model.make_model("rect1"), CONFIG, "rect1", (0.0, 0.0, 0.0), (0.08, 0.0, 0.0),
+                                    seed=2, loop=loop, position=source, motion_capture=False) for _ in range(2)]
+
+
+def test_perception_alone_gives_the_loop_its_state_and_the_same_seed_the_same_run(perceived):
+    first, second = perceived
+    np.testing.assert_array_equal(first.readings, second.readings)
+    np.testing.assert_array_equal(first.estimates, second.estimates)
+    np.testing.assert_array_equal(first.poses, second.poses)
+    # a reading every other control period (0.2 s), of the true scene's centre of mass
+    np.testing.assert_allclose(np.diff(first.readings[:, 0]), 2 * CONFIG.period, atol=1e-6)
+    truth = {round(t / CONFIG.period): pose for t, *pose in first.poses}
+    shape = get_object("rect1")
+    errors = [np.hypot(*(reading - planar.centre_of_mass(shape.centroid, truth[round(t / CONFIG.period)])))
+              for t, *reading in first.readings]
+    assert len(errors) >= 10 and np.max(errors) < 0.003, errors
+    # the filtered poses the plans start from follow the true pose though no motion capture is read
+    assert first.plans >= 5 and np.ptp(first.estimates[:, 0]) > 0.005
+    assert np.hypot(*(first.estimates[-1, :2] - first.poses[-1, 1:3])) < 0.004
+
+
+def test_the_loop_without_motion_capture_needs_a_position_source():
+    with pytest.raises(ValueError, match="position source"):
+        closed_loop.run_episode(model.make_model("rect1"), CONFIG, "rect1", (0.0, 0.0, 0.0), (0.05, 0.0, 0.0), seed=0,
+                                motion_capture=False)
+    with pytest.raises(ValueError, match="every"):
+        closed_loop.PositionSource(lambda obj, poses, pushers: poses[:, :2], (5e-4, 5e-4), every=0)
+    with pytest.raises(ValueError, match="std"):
+        closed_loop.PositionSource(lambda obj, poses, pushers: poses[:, :2], (5e-4, 0.0))

@@ -65,3 +65,15 @@ def test_the_loop_model_needs_its_file(tmp_path):
         push_to_goal.run(tmp_path, ("rect1",), 1, ["loop"], ["gradient"], 0, closed_loop.LoopConfig(),
                          loop_model=tmp_path / "model.json")
     assert not (tmp_path / "episodes.jsonl").exists()
+
+
+def test_state_sources_name_the_rows_and_perception_needs_a_source(tmp_path):
+    assert push_to_goal.label("lynch", "mocap", ["mocap"]) == "lynch"  # the default keeps the rows' names
+    assert push_to_goal.label("lynch", "mocap", ["mocap", "perception"]) == "lynch (mocap)"
+    assert push_to_goal.label("loop", "mocap+perception", ["mocap+perception"]) == "loop (mocap + perception)"
+    for states, message in ((["perception"], "position source"), (["mocap", "mocap"], "no repeats"),
+                            (["camera"], "expected a non-empty list"), ([], "expected a non-empty list")):
+        with pytest.raises(ValueError, match=message):
+            push_to_goal.run(tmp_path, ("rect1",), 1, ["lynch"], ["gradient"], 0, closed_loop.LoopConfig(),
+                             states=states)
+    assert not (tmp_path / "episodes.jsonl").exists()
