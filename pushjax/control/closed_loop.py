@@ -122,7 +122,8 @@ class EpisodeResult:
       stop: why pushing ended: ``"reached"``, ``"stuck"`` or ``"timeout"``.
       poses: [N, 4] true poses (t s, x m, y m, yaw rad) at the control periods' ends.
       pusher: [N, 3] pusher tip (t s, x m, y m) at the same times.
-      estimates: [P, 3] filtered poses the plans started from.
+      estimates: [P, 3] filtered poses the plans started from (and the last, at which pushing stopped).
+      estimate_times: [P] simulated seconds of the estimates (the true pose then: the row of `poses` at that time).
       readings: [R, 3] the position source's readings (t s, x m, y m; centre of mass); [0, 3] without one.
     """
 
@@ -139,6 +140,7 @@ class EpisodeResult:
     pusher: np.ndarray
     estimates: np.ndarray
     readings: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((0, 3)))
+    estimate_times: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
 
 
 @jax.jit
@@ -263,10 +265,11 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
         prior_std = np.concatenate([position.std, PRIOR_STD[2:]])
     mean = jnp.asarray(np.concatenate([observed, [0.0, 0.0]]), jnp.float32)
     cov = jnp.diag(jnp.asarray(prior_std, jnp.float32) ** 2)
-    estimates, plans, repositions, idle, stop = [], 0, 0, 0, "timeout"
+    estimates, estimate_times, plans, repositions, idle, stop = [], [], 0, 0, 0, "timeout"
     while episode.time < loop.max_time:
         estimate = np.asarray(mean[:3], np.float64)
         estimates.append(estimate)
+        estimate_times.append(episode.time)
         position_error = float(np.hypot(*(estimate[:2] - goal[:2])))
         if position_error < loop.stop_position and abs(float(wrap(estimate[2] - goal[2]))) < loop.stop_yaw:
             stop = "reached"
@@ -306,4 +309,5 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
         yaw_error=float(wrap(final[2] - goal[2])), path_length=path_length, time=episode.time,
         wall_time=time.perf_counter() - began, plans=plans, repositions=repositions, stop=stop, poses=poses,
         pusher=tips, estimates=np.asarray(estimates).reshape(-1, 3),
-        readings=np.concatenate(readings) if readings else np.zeros((0, 3)))
+        readings=np.concatenate(readings) if readings else np.zeros((0, 3)),
+        estimate_times=np.asarray(estimate_times, np.float64))
