@@ -6,7 +6,7 @@ r"""Push objects to goal poses with model-predictive control, closed on the MuJo
       [--planners=gradient,sampling] [--seed=0] [--surface=abs] [--testbed=realistic|ideal]
       [--testbed_overrides='drop_rate=0'] [--effects='table_tilt_deg=2'] [--max_time=60]
       [--states=mocap,mocap+perception,perception --perception=<a trained model's work directory or checkpoint>
-       [--perception_scale=cpu] [--perception_every=1]]
+       [--perception_scale=cpu] [--perception_every=1] [--perception_gate=13.8]]
 
 Draws the goals (``pushjax.control.goals``), runs every model and planner on each (``pushjax.control.push_to_goal``,
 resumable from ``--workdir``/episodes.jsonl) and writes ``results.json``, ``results.md`` and ``trajectories.png``.
@@ -15,7 +15,8 @@ resumable from ``--workdir``/episodes.jsonl) and writes ``results.json``, ``resu
 capture, motion capture and perception, perception only. Perception is the ``--perception`` model's (a hybrid trained
 on the ``data_efficiency`` dataset at ``--perception_scale``): the centre of mass it locates in the depth image of the
 true scene, rendered as its dataset renders examples, every ``--perception_every`` control periods
-(``pushjax.sensing.perception``); its noise is estimated on one push per object simulated with seed ``--seed`` + 1
+(``pushjax.sensing.perception``), a reading skipped when ``--perception_gate`` is given and its squared innovation
+exceeds it (``pushjax.control.closed_loop.PositionSource.gate``); its noise is estimated on one push per object simulated with seed ``--seed`` + 1
 (``pushjax.filter.tracking.simulate_pushes``), not on the evaluated episodes.
 """
 
@@ -58,6 +59,9 @@ _PERCEPTION_SCALE = flags.DEFINE_enum("perception_scale", "cpu", list(data_confi
                                       "camera and image size render the scenes).")
 _PERCEPTION_EVERY = flags.DEFINE_integer("perception_every", 1, "Control periods between perception readings.",
                                          lower_bound=1)
+_PERCEPTION_GATE = flags.DEFINE_float("perception_gate", None, "Skip a perception reading whose squared innovation "
+                                       "(chi-square, 2 degrees of freedom) exceeds this, e.g. 13.8 (99.9 %).",
+                                       lower_bound=1e-9)
 experiments.require_writable_folder("workdir")
 NOISE_PUSHES = 1
 """Pushes per object, simulated with seed --seed + 1, on which the perception's noise is estimated."""
@@ -65,6 +69,11 @@ NOISE_PUSHES = 1
 
 @flags.validator("max_time", "expected a finite number of seconds >= 1")
 def _check_max_time(value):
+    return value is None or math.isfinite(value)
+
+
+@flags.validator("perception_gate", "expected a finite chi-square bound > 0")
+def _check_gate(value):
     return value is None or math.isfinite(value)
 
 
@@ -120,7 +129,7 @@ def main(argv):
     loop = closed_loop.LoopConfig(max_time=_MAX_TIME.value or scale["max_time"], surface=_SURFACE.value,
                                   testbed=testbed, effects=Effects.parse(_EFFECTS.value))
     objects = _OBJECTS.value or scale["objects"]
-    for name in ("perception_scale", "perception_every"):
+    for name in ("perception_scale", "perception_every", "perception_gate"):
         if flags.FLAGS[name].present and _PERCEPTION.value is None:
             raise app.UsageError(f"--{name}: only used with --perception, which is not given")
     position, position_settings = None, None
@@ -135,7 +144,7 @@ def main(argv):
         noise_pushes = tracking.simulate_pushes(objects, NOISE_PUSHES, noise_seed, testbed, 1.0 / period)
         noise = perception.estimate_noise(sensor, noise_pushes, _PERCEPTION_EVERY.value)
         position = closed_loop.PositionSource(sensor.locate, tuple(max(v, 1e-5) for v in noise["std"]),
-                                              _PERCEPTION_EVERY.value, sensor.description)
+                                              _PERCEPTION_EVERY.value, sensor.description, _PERCEPTION_GATE.value)
         position_settings = {"model": _PERCEPTION.value, "dataset": f"data_efficiency/{_PERCEPTION_SCALE.value}",
                              "noise_seed": noise_seed, "noise_bias_m": noise["bias"], "noise_rmse_m": noise["rmse"],
                              "noise_readings": noise["readings"], "noise_pushes": noise["pushes"]}

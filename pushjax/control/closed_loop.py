@@ -93,16 +93,21 @@ class PositionSource:
       std: [2] standard deviation of a reading, world x and y, m (> 0; estimated on other pushes than the evaluated).
       every: control periods between readings (a reading at the end of every `every`-th period).
       description: the sensor in words (for the report).
+      gate: a reading whose squared innovation, in the units of its predicted covariance (chi-square, 2 degrees of
+        freedom), exceeds `gate` is skipped (None: every reading is used; e.g. 13.8, the 99.9 % quantile).
     """
 
     locate: Callable[[str, np.ndarray, np.ndarray], np.ndarray]
     std: tuple[float, float]
     every: int = 1
     description: str = ""
+    gate: float | None = None
 
     def __post_init__(self):
         if self.every < 1:
             raise ValueError(f"every: expected a whole number of control periods >= 1, got {self.every}")
+        if self.gate is not None and not (math.isfinite(self.gate) and self.gate > 0):
+            raise ValueError(f"gate: expected a positive chi-square bound, got {self.gate}")
         models.make_position_sensor("rect1", self.std)  # checks std
 
 
@@ -125,6 +130,7 @@ class EpisodeResult:
       estimates: [P, 3] filtered poses the plans started from (and the last, at which pushing stopped).
       estimate_times: [P] simulated seconds of the estimates (the true pose then: the row of `poses` at that time).
       readings: [R, 3] the position source's readings (t s, x m, y m; centre of mass); [0, 3] without one.
+      skipped_readings: readings the gate skipped (:attr:`PositionSource.gate`).
     """
 
     final_pose: np.ndarray
@@ -141,6 +147,7 @@ class EpisodeResult:
     estimates: np.ndarray
     readings: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((0, 3)))
     estimate_times: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
+    skipped_readings: int = 0
 
 
 @jax.jit
@@ -152,6 +159,19 @@ def filter_period(system: models.System, mean, cov, pusher, increment, measureme
 
 position_update = jax.jit(models.update_position)
 """(mean [5], cov [5, 5]) after a position reading (:func:`pushjax.filter.models.update_position`), compiled."""
+
+
+@jax.jit
+def gated_position_update(sensor: models.PositionSensor, mean, cov, reading, gate):
+    """(mean [5], cov [5, 5], used []) after a position `reading` [2] (world, m;
+    :func:`pushjax.filter.models.update_position`), unchanged (used False) where the reading's squared innovation in
+    units of its predicted covariance exceeds `gate`."""
+    innovation = reading - models.observe_position(sensor, mean)
+    h = jax.jacfwd(models.observe_position, argnums=1)(sensor, mean)
+    predicted = h @ cov @ h.T + jnp.diag(sensor.std.astype(cov.dtype) ** 2)
+    used = innovation @ jnp.linalg.solve(predicted, innovation) <= gate
+    new_mean, new_cov = models.update_position(sensor, mean, cov, reading)
+    return jnp.where(used, new_mean, mean), jnp.where(used, new_cov, cov), used
 
 
 def waypoint_targets(start, waypoints, step: float, multiple: int) -> np.ndarray:
@@ -265,7 +285,7 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
         prior_std = np.concatenate([position.std, PRIOR_STD[2:]])
     mean = jnp.asarray(np.concatenate([observed, [0.0, 0.0]]), jnp.float32)
     cov = jnp.diag(jnp.asarray(prior_std, jnp.float32) ** 2)
-    estimates, estimate_times, plans, repositions, idle, stop = [], [], 0, 0, 0, "timeout"
+    estimates, estimate_times, plans, repositions, idle, stop, skipped = [], [], 0, 0, 0, "timeout", 0
     while episode.time < loop.max_time:
         estimate = np.asarray(mean[:3], np.float64)
         estimates.append(estimate)
@@ -298,8 +318,11 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
         for begin, end, measurement, reading in zip(path[:-1], path[1:], measurements.astype(np.float32),
                                                     found.astype(np.float32)):
             mean, cov = filter_period(system, mean, cov, begin, end - begin, measurement)
-            if np.all(np.isfinite(reading)):
+            if np.all(np.isfinite(reading)) and position.gate is None:
                 mean, cov = position_update(sensor, mean, cov, reading)
+            elif np.all(np.isfinite(reading)):
+                mean, cov, used = gated_position_update(sensor, mean, cov, reading, position.gate)
+                skipped += not bool(used)
     execute(np.repeat(episode.pusher[None], max(1, round(loop.settle / config.period)) * samples_per_period, axis=0),
             read=False)
     poses, tips = np.concatenate(poses), np.concatenate(tips)
@@ -310,4 +333,4 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
         wall_time=time.perf_counter() - began, plans=plans, repositions=repositions, stop=stop, poses=poses,
         pusher=tips, estimates=np.asarray(estimates).reshape(-1, 3),
         readings=np.concatenate(readings) if readings else np.zeros((0, 3)),
-        estimate_times=np.asarray(estimate_times, np.float64))
+        estimate_times=np.asarray(estimate_times, np.float64), skipped_readings=skipped)

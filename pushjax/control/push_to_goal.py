@@ -175,6 +175,8 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
     if perceives:
         settings["position"] = {"description": position.description, "std_m": list(position.std),
                                 "every_periods": position.every, **(position_settings or {})}
+        if position.gate is not None:
+            settings["position"]["gate"] = position.gate
     fingerprint = _fingerprint(settings)
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)

@@ -29,7 +29,10 @@ def episode_row(task: goals.Goal, result, stride: int) -> dict:
         "position_error_mm": 1e3 * result.position_error, "yaw_error_deg": math.degrees(result.yaw_error),
         "success": goals.succeeded(result.position_error, result.yaw_error), "path_length_m": result.path_length,
         "time_s": result.time, "wall_s": result.wall_time, "plans": result.plans, "repositions": result.repositions,
-        "stop": result.stop, "trajectory": {"poses": result.poses[keep].tolist(), "pusher": result.pusher[keep].tolist()},
+        "stop": result.stop,
+        **({"readings": len(result.readings), "skipped_readings": result.skipped_readings} if len(result.readings)
+           else {}),
+        "trajectory": {"poses": result.poses[keep].tolist(), "pusher": result.pusher[keep].tolist()},
     }
 
 
@@ -124,8 +127,10 @@ def table(results: dict) -> str:
     position = results["settings"].get("position")
     if position:
         noise = ", ".join(f"{1e3 * value:.2f}" for value in position["std_m"])
+        gate = f", readings beyond a squared innovation of {position['gate']:g} skipped" if "gate" in position else ""
         lines += [f"State sources: {', '.join(results['settings']['states'])}; perception: {position['description']}, "
-                  f"a reading every {position['every_periods']} control period(s), noise std {noise} mm (x, y).", ""]
+                  f"a reading every {position['every_periods']} control period(s), noise std {noise} mm (x, y){gate}.",
+                  ""]
     lines += [header.format("model / planner")]
     lines += [_line(name, entry) for name, entry in results["summary"].items()]
     if results.get("comparisons"):
