@@ -103,14 +103,14 @@ def test_the_loop_without_motion_capture_needs_a_position_source():
 
 def test_the_gate_skips_a_reading_far_from_the_prediction():
     sensor = models.make_position_sensor("tri2", (5e-4, 5e-4))
-    mean = jnp.array([0.1, 0.0, 0.3, 0.0, 0.0])
-    cov = jnp.diag(jnp.array([1e-3, 1e-3, 0.02, 0.3, 0.3]) ** 2)
-    near = models.observe_position(sensor, mean) + jnp.array([1e-3, -1e-3])
-    far = models.observe_position(sensor, mean) + jnp.array([0.03, 0.0])  # 30 standard deviations off
+    mean = jnp.array([0.1, 0.0, 0.3, 0.0, 0.0], jnp.float32)
+    cov = jnp.diag(jnp.array([1e-3, 1e-3, 0.02, 0.3, 0.3], jnp.float32) ** 2)
+    centre = jnp.asarray(planar.centre_of_mass(get_object("tri2").centroid, np.asarray(mean[:3])), jnp.float32)
+    near, far = centre + jnp.array([1e-3, -1e-3]), centre + jnp.array([0.03, 0.0])  # far: 30 standard deviations off
     for reading, expected in ((near, True), (far, False)):
         new_mean, new_cov, used = closed_loop.gated_position_update(sensor, mean, cov, reading, 13.8)
         assert bool(used) == expected
-        reference = models.update_position(sensor, mean, cov, reading) if expected else (mean, cov)
+        reference = closed_loop.position_update(sensor, mean, cov, reading) if expected else (mean, cov)
         np.testing.assert_allclose(new_mean, reference[0], rtol=1e-5, atol=1e-7)
         np.testing.assert_allclose(new_cov, reference[1], rtol=1e-5, atol=1e-10)
     with pytest.raises(ValueError, match="gate"):
