@@ -135,8 +135,7 @@ def main(argv):
     position, position_settings = None, None
     if _PERCEPTION.value is not None:
         try:
-            sensor = perception.load(_PERCEPTION.value, data_configs.get_config("data_efficiency",
-                                                                                _PERCEPTION_SCALE.value))
+            sensor = perception.load_data_efficiency(_PERCEPTION.value, _PERCEPTION_SCALE.value)
         except ValueError as error:
             raise app.UsageError(f"--perception: {' '.join(str(error).split())}") from None
         period = scale["controller"].period

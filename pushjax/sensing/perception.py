@@ -34,14 +34,14 @@ from collections.abc import Sequence
 import numpy as np
 
 from pushjax import planar
-from pushjax.data.configs import DatasetConfig
+from pushjax.data.configs import DatasetConfig, get_config
 from pushjax.data.examples import make_renderer
 from pushjax.filter.tracking import PositionStream, TrackedPush
 from pushjax.geometry.objects import get_object, limit_surface_ratio
 from pushjax.render.renderer import DepthRenderer
 from pushjax.train.predictor import Predictor, load_model
 
-__all__ = ["BATCH", "PerceptionSensor", "estimate_noise", "load", "readings", "stream"]
+__all__ = ["BATCH", "PerceptionSensor", "estimate_noise", "load", "load_data_efficiency", "readings", "stream"]
 
 BATCH = 32
 """Images per call of the network: a shorter batch is padded to it, so the network compiles once."""
@@ -103,6 +103,12 @@ def load(path: str | os.PathLike, dataset: DatasetConfig, model: int | str = -1,
     folder; `model` as in :func:`pushjax.train.predictor.load_model`, whose ValueError names what is wrong), trained
     on `dataset`. Reads only."""
     return PerceptionSensor(load_model(path, model=model), dataset, surface)
+
+
+def load_data_efficiency(path: str | os.PathLike, scale: str) -> PerceptionSensor:
+    """:func:`load` of a model trained on the ``data_efficiency`` dataset at `scale` (``pushjax.data.configs.SCALES``),
+    as the binaries' ``--perception`` and ``--perception_scale`` name it; a ValueError names what is wrong."""
+    return load(path, get_config("data_efficiency", scale))
 
 
 def readings(sensor: PerceptionSensor, pushes: Sequence[TrackedPush], every: int) -> dict[str, np.ndarray]:
