@@ -108,7 +108,7 @@ class PositionSource:
             raise ValueError(f"every: expected a whole number of control periods >= 1, got {self.every}")
         if self.gate is not None and not (math.isfinite(self.gate) and self.gate > 0):
             raise ValueError(f"gate: expected a positive chi-square bound, got {self.gate}")
-        models.make_position_sensor("rect1", self.std)  # checks std
+        models.checked_position_std(self.std)
 
 
 @dataclasses.dataclass(frozen=True)

@@ -42,8 +42,8 @@ from pushjax.physics import effects as effects_lib
 from pushjax.physics import rollout
 
 __all__ = ["POSE_SIZE", "POSITION_SIZE", "STATE_NAMES", "STATE_SIZE", "PositionSensor", "System", "Track",
-           "innovation", "make_position_sensor", "make_system", "observe", "observe_position", "observed", "physical",
-           "transition", "update", "update_linear", "update_position"]
+           "checked_position_std", "innovation", "make_position_sensor", "make_system", "observe", "observe_position",
+           "observed", "physical", "transition", "update", "update_linear", "update_position"]
 
 STATE_NAMES = ("x", "y", "yaw", "log_mu_scale", "log_l_scale")
 STATE_SIZE = len(STATE_NAMES)
@@ -178,10 +178,15 @@ class PositionSensor:
 def make_position_sensor(obj: PushObject | str, std: Sequence[float], dtype=jnp.float32) -> PositionSensor:
     """The :class:`PositionSensor` of `obj`'s centre of mass with reading noise `std` [2] (world x m, y m; > 0)."""
     obj = get_object(obj) if isinstance(obj, str) else obj
+    return PositionSensor(offset=jnp.asarray(obj.centroid, dtype), std=jnp.asarray(checked_position_std(std), dtype))
+
+
+def checked_position_std(std: Sequence[float]) -> np.ndarray:
+    """`std` [2] (world x m, y m) as an array, or a ValueError naming ``std`` unless both are finite and positive."""
     std = np.asarray(std, np.float64)
     if std.shape != (POSITION_SIZE,) or not np.all(np.isfinite(std) & (std > 0)):
         raise ValueError(f"std: expected {POSITION_SIZE} positive values (m), got {std.tolist()}")
-    return PositionSensor(offset=jnp.asarray(obj.centroid, dtype), std=jnp.asarray(std, dtype))
+    return std
 
 
 def observe_position(sensor: PositionSensor, state):
