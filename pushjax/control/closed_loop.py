@@ -157,21 +157,9 @@ def filter_period(system: models.System, mean, cov, pusher, increment, measureme
     return models.update_linear(system, *ekf.predict(system, mean, cov, pusher, increment), measurement)
 
 
-position_update = jax.jit(models.update_position)
-"""(mean [5], cov [5, 5]) after a position reading (:func:`pushjax.filter.models.update_position`), compiled."""
-
-
-@jax.jit
-def gated_position_update(sensor: models.PositionSensor, mean, cov, reading, gate):
-    """(mean [5], cov [5, 5], used []) after a position `reading` [2] (world, m;
-    :func:`pushjax.filter.models.update_position`), unchanged (used False) where the reading's squared innovation in
-    units of its predicted covariance exceeds `gate`."""
-    innovation = reading - models.observe_position(sensor, mean)
-    h = jax.jacfwd(models.observe_position, argnums=1)(sensor, mean)
-    predicted = h @ cov @ h.T + jnp.diag(sensor.std.astype(cov.dtype) ** 2)
-    used = innovation @ jnp.linalg.solve(predicted, innovation) <= gate
-    new_mean, new_cov = models.update_position(sensor, mean, cov, reading)
-    return jnp.where(used, new_mean, mean), jnp.where(used, new_cov, cov), used
+position_update = jax.jit(models.gated_update_position)
+"""(mean [5], cov [5, 5], used []) after a position reading and its gate
+(:func:`pushjax.filter.models.gated_update_position`), compiled."""
 
 
 def waypoint_targets(start, waypoints, step: float, multiple: int) -> np.ndarray:
@@ -243,6 +231,7 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
     goal_array = jnp.asarray(goal, jnp.float32)
 
     sensor = None if position is None else models.make_position_sensor(model.shape, position.std)
+    gate = math.inf if position is None or position.gate is None else position.gate
     poses, tips, readings = [], [], []
     path_length = 0.0
     periods = 0
@@ -318,10 +307,8 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
         for begin, end, measurement, reading in zip(path[:-1], path[1:], measurements.astype(np.float32),
                                                     found.astype(np.float32)):
             mean, cov = filter_period(system, mean, cov, begin, end - begin, measurement)
-            if np.all(np.isfinite(reading)) and position.gate is None:
-                mean, cov = position_update(sensor, mean, cov, reading)
-            elif np.all(np.isfinite(reading)):
-                mean, cov, used = gated_position_update(sensor, mean, cov, reading, position.gate)
+            if np.all(np.isfinite(reading)):
+                mean, cov, used = position_update(sensor, mean, cov, reading, gate)
                 skipped += not bool(used)
     execute(np.repeat(episode.pusher[None], max(1, round(loop.settle / config.period)) * samples_per_period, axis=0),
             read=False)

@@ -43,7 +43,8 @@ from pushjax.physics import rollout
 
 __all__ = ["POSE_SIZE", "POSITION_SIZE", "STATE_NAMES", "STATE_SIZE", "PositionSensor", "System", "Track",
            "checked_position_std", "innovation", "make_position_sensor", "make_system", "observe", "observe_position",
-           "observed", "physical", "transition", "update", "update_linear", "update_position"]
+           "gated_update_position", "observed", "physical", "transition", "update", "update_linear",
+           "update_position"]
 
 STATE_NAMES = ("x", "y", "yaw", "log_mu_scale", "log_l_scale")
 STATE_SIZE = len(STATE_NAMES)
@@ -196,21 +197,31 @@ def observe_position(sensor: PositionSensor, state):
     return state[:2] + jnp.stack([cos * offset[0] - sin * offset[1], sin * offset[0] + cos * offset[1]])
 
 
-def update_position(sensor: PositionSensor, mean, cov, position):
-    """Kalman update of a Gaussian belief (mean [5], cov [5, 5]) with a position reading [2] (world, m), the
-    observation linearised at `mean` (the EKF's update; exact for a sensor whose point is the tracked frame's
-    origin); a missing reading (any NaN) leaves the belief unchanged. Joseph form, symmetrised."""
+def gated_update_position(sensor: PositionSensor, mean, cov, position, gate=jnp.inf):
+    """(mean [5], cov [5, 5], used []) after the Kalman update of a Gaussian belief (mean [5], cov [5, 5]) with a
+    position reading [2] (world, m), the observation linearised at `mean` (the EKF's update; exact for a sensor whose
+    point is the tracked frame's origin). The belief is unchanged (used False) where the reading is missing (any NaN)
+    or its squared innovation in units of its predicted covariance exceeds `gate` (a chi-square bound with 2 degrees
+    of freedom; infinite: no gate). Joseph form, symmetrised."""
     predicted = observe_position(sensor, mean)
     h = jax.jacfwd(observe_position, argnums=1)(sensor, mean)
     r = jnp.diag(sensor.std.astype(cov.dtype) ** 2)
     s = h @ cov @ h.T + r
     gain = jnp.linalg.solve(s, h @ cov).T
     present = jnp.all(jnp.isfinite(position))
-    new_mean = mean + gain @ (jnp.where(present, position, predicted) - predicted)
+    innovation = jnp.where(present, position, predicted) - predicted
+    used = present & (innovation @ jnp.linalg.solve(s, innovation) <= gate)
+    new_mean = mean + gain @ innovation
     factor = jnp.eye(STATE_SIZE, dtype=cov.dtype) - gain @ h
     new_cov = factor @ cov @ factor.T + gain @ r @ gain.T
     new_cov = 0.5 * (new_cov + new_cov.T)
-    return jnp.where(present, new_mean, mean), jnp.where(present, new_cov, cov)
+    return jnp.where(used, new_mean, mean), jnp.where(used, new_cov, cov), used
+
+
+def update_position(sensor: PositionSensor, mean, cov, position):
+    """(mean [5], cov [5, 5]) after a position reading [2] (world, m): :func:`gated_update_position` without a gate;
+    a missing reading (any NaN) leaves the belief unchanged."""
+    return gated_update_position(sensor, mean, cov, position)[:2]
 
 
 def update(system: System, mean, cov, measurement, sensor: PositionSensor | None = None, position=None):

@@ -108,9 +108,9 @@ def test_the_gate_skips_a_reading_far_from_the_prediction():
     centre = jnp.asarray(planar.centre_of_mass(get_object("tri2").centroid, np.asarray(mean[:3])), jnp.float32)
     near, far = centre + jnp.array([1e-3, -1e-3]), centre + jnp.array([0.03, 0.0])  # far: 30 standard deviations off
     for reading, expected in ((near, True), (far, False)):
-        new_mean, new_cov, used = closed_loop.gated_position_update(sensor, mean, cov, reading, 13.8)
+        new_mean, new_cov, used = closed_loop.position_update(sensor, mean, cov, reading, 13.8)
         assert bool(used) == expected
-        reference = closed_loop.position_update(sensor, mean, cov, reading) if expected else (mean, cov)
+        reference = models.update_position(sensor, mean, cov, reading) if expected else (mean, cov)
         np.testing.assert_allclose(new_mean, reference[0], rtol=1e-5, atol=1e-7)
         np.testing.assert_allclose(new_cov, reference[1], rtol=1e-5, atol=1e-10)
     with pytest.raises(ValueError, match="gate"):
