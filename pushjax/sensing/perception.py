@@ -44,7 +44,8 @@ from pushjax.train.predictor import Predictor, load_model
 __all__ = ["BATCH", "PerceptionSensor", "estimate_noise", "load", "load_data_efficiency", "readings", "stream"]
 
 BATCH = 32
-"""Images per call of the network: a shorter batch is padded to it, so the network compiles once."""
+"""The most images per call of the network; a shorter batch is padded to the next power of two, so the network
+compiles at most six times and a single reading runs the network on one image."""
 
 
 @dataclasses.dataclass
@@ -89,11 +90,11 @@ class PerceptionSensor:
         for start in range(0, len(poses), BATCH):
             pose, pusher = poses[start:start + BATCH], pushers[start:start + BATCH]
             depth = np.stack([renderer.depth(p, q) for p, q in zip(pose, pusher)])
-            pad = BATCH - len(depth)
+            pad = (1 << (len(depth) - 1).bit_length()) - len(depth)
             depth = np.concatenate([depth, np.repeat(depth[-1:], pad, axis=0)])
             pusher = np.concatenate([pusher, np.repeat(pusher[-1:], pad, axis=0)])
             prediction = self.predictor(depth, pusher, np.zeros(2), renderer.camera, l, mu)
-            located.append(np.asarray(prediction.object_pos, np.float64)[:BATCH - pad])
+            located.append(np.asarray(prediction.object_pos, np.float64)[:len(depth) - pad])
         return np.concatenate(located) if located else np.zeros((0, 2))
 
 
