@@ -193,7 +193,8 @@ def markdown(results: Mapping) -> str:
             + metrics_table(largest, ["model"], STATE_METRICS, paper=_paper_cells(name, sizes, STATE_METRICS)),
             *([f"## Learning curves at {_largest_size(trained)} training examples\n\n"
                + curves_table(results["curves"], _largest_size(trained))] if results.get("curves") else []),
-            *([convergence_table(trained, results["config"].get("criterion"))]
+            *([convergence_table([row for row in results["rows"] if row["kind"] == "trained"],
+                                 results["config"].get("criterion"))]
               if any("converged" in row for row in trained) else []),
         ]) + "\n"
     if name in ("velocities", "error_velocities", "objects"):
@@ -218,7 +219,8 @@ def markdown(results: Mapping) -> str:
 
 
 def convergence_table(trained: Sequence[Mapping], criterion: Mapping | None) -> str:
-    """Per model and size: how many seeds met the convergence criterion and the steps they took (issue 30)."""
+    """Per model and size: how many seeds met the convergence criterion and the steps they took (issue 30), from the
+    `trained` rows of each seed (not merged over seeds)."""
     rule = ""
     if criterion:
         rule = (f" The criterion: the best validation score of the last {criterion['window']} evaluations (one every "

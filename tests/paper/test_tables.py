@@ -26,6 +26,16 @@ def test_aggregate_averages_seeds_and_combines_standard_errors():
     assert row["rot_percent_se_sequences"] is None and row["rot_percent_se"] == pytest.approx(10.0)
 
 
+def test_the_convergence_table_counts_every_seed(tmp_path, monkeypatch):
+    monkeypatch.setenv("PUSHJAX_PAPER_TABLES", str(tmp_path / "absent.json"))
+    rows = [{**_row("neural", 2500, seed, 30.0, 1.0), "converged": seed == 1, "steps": steps}
+            for seed, steps in ((0, 11000), (1, 9000), (2, 11000))]
+    results = {"name": "data_efficiency_full", "rows": rows,
+               "config": {"experiment": "data_efficiency", "scale": "cpu_full", "seeds": [0, 1, 2],
+                          "criterion": {"window": 5, "eval_every": 1000, "min_improvement": 0.01}}}
+    assert "| neural | 1/3 met, 10,333 steps |" in tables.markdown(results)
+
+
 def test_pivot_table_repeats_baselines_in_every_size_column():
     rows = [_row("zero", None, None, 100.0, 1.0), _row("hybrid", 100, 0, 10.0, 1.0), _row("hybrid", 2500, 0, 5.0, 0.5)]
     table = tables.pivot_table(tables.aggregate(rows), ["model"], "train_size")
