@@ -13,7 +13,9 @@ A unit of work is one model. When it is trained and evaluated, its record -- the
 to ``<workdir>/models/<key>.json`` (a few tens of KiB), and ``results.json``, ``results.md`` and the figures are
 assembled again from every record present. A later run with the same work directory skips every model that has a
 record, so the run resumes across sittings and fresh checkouts as long as the records are kept (committed); a
-model interrupted before its record is written is trained again from the start. The dataset is rebuilt from its
+model interrupted before its record is written continues from its training state, saved every 1 000 steps to
+``<workdir>/in_training/<key>/`` (`pushjax.train.convergence`, not committed; removed once the record is written), to
+the same parameters and record as without the interruption. The dataset is rebuilt from its
 seed when missing. Each trained model's parameters go to ``<workdir>/checkpoints/<key>/`` (not committed), from which
 ``pushjax.load_model(workdir, model=key)`` loads it to predict; models recorded before the run kept them have none.
 """
@@ -50,6 +52,8 @@ WIDE_VARIANTS = ("neural", "hybrid")
 SCALE = "cpu_full"
 CHECKPOINTS = "checkpoints"
 """The work directory's folder of one checkpoint folder per trained model (named by its key)."""
+IN_TRAINING = "in_training"
+"""The work directory's folder of the training state of each model being trained (named by its key)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -131,20 +135,22 @@ def train_config(spec: spec_lib.ExperimentSpec, unit: Unit) -> train_lib.TrainCo
 def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Mapping, validation: Mapping,
                test: Mapping, criterion: convergence.Criterion = convergence.CRITERION,
                log: Callable[[str], None] | None = None, tensorboard_dir: str | Path | None = None,
-               checkpoint_dir: str | Path | None = None) -> dict:
+               checkpoint_dir: str | Path | None = None, resume_dir: str | Path | None = None) -> dict:
     """Trains and evaluates one model; returns its record. With `tensorboard_dir`, the model's scores go to the
-    TensorBoard run ``<tensorboard_dir>/<unit key>/train`` (restarted with the model); with `checkpoint_dir`, its
-    parameters to a checkpoint there (`pushjax.train.predictor.save_model`, replacing any earlier one)."""
+    TensorBoard run ``<tensorboard_dir>/<unit key>/train`` (from the step it resumes at); with `checkpoint_dir`, its
+    parameters to a checkpoint there (`pushjax.train.predictor.save_model`, replacing any earlier one); with
+    `resume_dir`, its training state is saved there as it trains and a later call continues from it
+    (`pushjax.train.convergence.train_until_converged`)."""
     count = len(train_examples["motion"])
     size = min(unit.size, count)
     (model_spec,) = train_lib.subset_specs(count, (size,), (unit.seed,))
     config = train_config(spec, unit)
     started = datetime.datetime.now(datetime.timezone.utc)
-    tensorboard = (None if tensorboard_dir is None else
-                   train_lib.metrics_log.TensorBoardLog(tensorboard_dir, [unit.key], "train", first_step=0))
+    tensorboard = (None if tensorboard_dir is None else train_lib.metrics_log.TensorBoardLog(
+        tensorboard_dir, [unit.key], "train", first_step=convergence.resumed_step(resume_dir)))
     try:
         trained = convergence.train_until_converged(config, train_examples, model_spec, validation, criterion, log=log,
-                                                    tensorboard=tensorboard)
+                                                    tensorboard=tensorboard, resume_dir=resume_dir)
     finally:
         if tensorboard is not None:
             tensorboard.close()
@@ -205,8 +211,8 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
 
     Args:
       spec: `make_spec`.
-      workdir: the records (``models/``), ``baselines.json``, ``results.json`` and the models' checkpoints
-        (``checkpoints/``).
+      workdir: the records (``models/``), ``baselines.json``, ``results.json``, the models' checkpoints
+        (``checkpoints/``) and the training state of a model being trained (``in_training/``).
       units: `plan`.
       max_models: train at most this many models in this call (None: all).
       deadline: start no model after this time (UTC).
@@ -237,9 +243,14 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
                 break
             log(f"{NAME}: training {unit.key} (budget {criterion.budget(min(unit.size, len(train_examples['motion'])))}"
                 " constant-rate steps)")
+            resume_dir = workdir / IN_TRAINING / unit.key
+            if (resumed := convergence.resumed_step(resume_dir)):
+                log(f"{NAME}: {unit.key} continues from step {resumed}")
             record = train_unit(spec, unit, train_examples, validation, test, criterion, log,
-                                workdir / train_lib.metrics_log.TENSORBOARD_DIR, workdir / CHECKPOINTS / unit.key)
+                                workdir / train_lib.metrics_log.TENSORBOARD_DIR, workdir / CHECKPOINTS / unit.key,
+                                resume_dir)
             _write_json(workdir / "models" / f"{unit.key}.json", record)
+            shutil.rmtree(resume_dir)
             trained += 1
             row = record["row"]
             log(f"{NAME}: recorded {unit.key}: {row['steps']} steps ({'converged' if row['converged'] else 'budget'}"

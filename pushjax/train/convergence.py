@@ -14,7 +14,10 @@ learning rate to `Criterion.final_lr_fraction` of it follows (`Criterion.decay_s
 phase, at least `Criterion.min_decay_steps`), and the model after the decay is the one evaluated.
 
 One model per call: the unit of work of a resumable run whose finished models are recorded as they finish
-(`pushjax.paper.full_run`).
+(`pushjax.paper.full_run`). With a `resume_dir` the model's training state, its scores and the criterion's progress
+are saved every `Criterion.eval_every` steps (constant phase and decay), and a call with the same folder continues
+from the last save: the batches depend only on the model's spec and the step, so a resumed model ends with the same
+parameters, scores and verdict as an uninterrupted one.
 """
 
 from __future__ import annotations
@@ -22,8 +25,10 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import os
 import time
 from collections.abc import Callable, Sequence
+from pathlib import Path
 
 import jax
 import jax.numpy as jnp
@@ -32,6 +37,7 @@ import optax
 
 from pushjax.models import ModelConfig, PushModel
 from pushjax.train.batching import Examples, ModelSpec, batch_indices, gather, model_fields
+from pushjax.train.checkpoint import Checkpointer
 from pushjax.train.configs import TrainConfig
 from pushjax.train.evaluate import error_metrics, predict
 from pushjax.train.metrics_log import TensorBoardLog
@@ -104,7 +110,7 @@ class ConvergedModel:
       decay_steps: steps of the decay.
       validation: [(step, trans_percent, rot_percent)] every validation evaluation (its score: their mean), the one
         after the decay last.
-      seconds: wall time of the training and its validation scores.
+      seconds: wall time of the training and its validation scores (of every call, when resumed).
       steps_per_second: training steps per second (validation excluded).
     """
 
@@ -143,10 +149,22 @@ def _compiled_step(model_config: ModelConfig, physics: Callable | None, learning
     return model, optimizer, jax.jit(make_train_step(model, optimizer, weight_decay))
 
 
+def resumed_step(resume_dir: str | os.PathLike | None) -> int:
+    """The step at which `train_until_converged` with this `resume_dir` continues (0: nothing saved)."""
+    if resume_dir is None or not Path(resume_dir).is_dir():
+        return 0
+    checkpointer = Checkpointer(resume_dir)
+    try:
+        return checkpointer.latest_step() or 0
+    finally:
+        checkpointer.close()
+
+
 def train_until_converged(
     train_config: TrainConfig, examples: Examples, spec: ModelSpec, validation: Examples,
     criterion: Criterion = CRITERION, *, physics: Callable | None = None,
     log: Callable[[str], None] | None = None, tensorboard: TensorBoardLog | None = None,
+    resume_dir: str | os.PathLike | None = None,
 ) -> ConvergedModel:
     """Trains one model (`train_config.model`, the subset and seed of `spec`) by `criterion`.
 
@@ -159,9 +177,12 @@ def train_until_converged(
       criterion: the convergence criterion and budget.
       physics: replaces `PushModel.physics`.
       log: called with a line after every validation score.
-      tensorboard: a log of this one model (`pushjax.train.metrics_log.TensorBoardLog`) that gets every validation
-        score (``validation/trans_percent``, ``validation/rot_percent``, ``validation/score``), the training loss and
-        the steps per second of the constant phase, or None.
+      tensorboard: a log of this one model (`pushjax.train.metrics_log.TensorBoardLog`, its first step
+        `resumed_step(resume_dir)`) that gets every validation score (``validation/trans_percent``,
+        ``validation/rot_percent``, ``validation/score``), the training loss and the steps per second of the constant
+        phase, or None.
+      resume_dir: a folder for the training state every `Criterion.eval_every` steps, from which a later call with the
+        same arguments continues (None: not saved). The caller removes it once the model is kept elsewhere.
     """
     model, optimizer, step_fn = _compiled_step(train_config.model, physics, train_config.learning_rate,
                                                train_config.weight_decay)
@@ -174,10 +195,17 @@ def train_until_converged(
     state = create_train_state(model, optimizer, batch_at(0), spec.seed)
     state = _with_learning_rate(state, train_config.learning_rate)
     budget = criterion.budget(size)
-    scores: list[float] = []
-    history: list[tuple[int, float, float]] = []
-    started, train_seconds = time.monotonic(), 0.0
-    step, converged = 0, False
+    step = 0
+    progress = {"scores": [], "validation": [], "converged": False, "constant_steps": None, "train_seconds": 0.0,
+                "seconds": 0.0}
+    checkpointer = None if resume_dir is None else Checkpointer(resume_dir, max_to_keep=1)
+    if checkpointer is not None and (restored := checkpointer.restore_latest(state)) is not None:
+        step, state, progress = restored
+    scores: list[float] = list(progress["scores"])
+    history: list[tuple[int, float, float]] = [tuple(point) for point in progress["validation"]]
+    converged, constant_steps = bool(progress["converged"]), progress["constant_steps"]
+    started, train_seconds = time.monotonic(), float(progress["train_seconds"])
+    metrics = None
 
     def score_now(label: str, scalars: dict[str, float]) -> float:
         trans, rot = validation_errors(model, state, validation, train_config.eval_batch_size)
@@ -191,31 +219,44 @@ def train_until_converged(
             log(f"{spec.name}: step {step} ({label}) validation score {score:.2f}")
         return score
 
-    while step < budget:
-        chunk = time.monotonic()
-        for _ in range(criterion.eval_every):
-            state, metrics = step_fn(state, batch_at(step))
-            step += 1
-        jax.block_until_ready(state.params)
-        train_seconds += time.monotonic() - chunk
-        scores.append(score_now("constant", {"loss": float(metrics["loss"]),
-                                             "steps_per_second": criterion.eval_every / (time.monotonic() - chunk)}))
-        if criterion.plateaued(scores):
-            converged = True
-            break
-    constant_steps = step
-    decay_steps = criterion.decay_steps(constant_steps)
-    lr = train_config.learning_rate
-    chunk = time.monotonic()
-    for index in range(decay_steps):
-        progress = (index + 1) / decay_steps
-        cosine = 0.5 * (1.0 + math.cos(math.pi * progress))
-        state = _with_learning_rate(state, lr * (criterion.final_lr_fraction + (1 - criterion.final_lr_fraction)
-                                                 * cosine))
-        state, metrics = step_fn(state, batch_at(step))
-        step += 1
-    jax.block_until_ready(state.params)
-    train_seconds += time.monotonic() - chunk
-    score_now("after the decay", {"loss": float(metrics["loss"])} if decay_steps else {})
+    def save():
+        if checkpointer is not None:
+            checkpointer.save(step, state, {
+                "scores": scores, "validation": history, "converged": converged, "constant_steps": constant_steps,
+                "train_seconds": train_seconds, "seconds": progress["seconds"] + time.monotonic() - started})
+
+    try:
+        while constant_steps is None:
+            chunk = time.monotonic()
+            for _ in range(criterion.eval_every):
+                state, metrics = step_fn(state, batch_at(step))
+                step += 1
+            jax.block_until_ready(state.params)
+            train_seconds += time.monotonic() - chunk
+            scores.append(score_now("constant", {"loss": float(metrics["loss"]), "steps_per_second":
+                                                 criterion.eval_every / (time.monotonic() - chunk)}))
+            converged = criterion.plateaued(scores)
+            if converged or step >= budget:
+                constant_steps = step
+            save()
+        decay_steps = criterion.decay_steps(constant_steps)
+        lr = train_config.learning_rate
+        while step < constant_steps + decay_steps:
+            chunk = time.monotonic()
+            for _ in range(min(criterion.eval_every, constant_steps + decay_steps - step)):
+                progress_fraction = (step - constant_steps + 1) / decay_steps
+                cosine = 0.5 * (1.0 + math.cos(math.pi * progress_fraction))
+                state = _with_learning_rate(state, lr * (criterion.final_lr_fraction
+                                                         + (1 - criterion.final_lr_fraction) * cosine))
+                state, metrics = step_fn(state, batch_at(step))
+                step += 1
+            jax.block_until_ready(state.params)
+            train_seconds += time.monotonic() - chunk
+            save()
+    finally:
+        if checkpointer is not None:
+            checkpointer.close()
+    score_now("after the decay", {"loss": float(metrics["loss"])} if metrics is not None else {})
     return ConvergedModel(model, state, converged, constant_steps, decay_steps, history,
-                          time.monotonic() - started, step / train_seconds if train_seconds > 0 else float("nan"))
+                          progress["seconds"] + time.monotonic() - started,
+                          step / train_seconds if train_seconds > 0 else float("nan"))

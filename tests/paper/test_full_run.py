@@ -62,7 +62,9 @@ def test_a_fresh_checkout_trains_only_the_missing_models(smoke_results, smoke_da
     after = {path.name: path.read_text() for path in records.iterdir()}
     assert set(after) == set(before)
     assert all(after[name] == text for name, text in before.items() if name != "hybrid_80_seed0.json")
+    assert json.loads(after["hybrid_80_seed0.json"])["row"] == json.loads(before["hybrid_80_seed0.json"])["row"]
     assert json.loads((workdir / "results.json").read_text())["progress"]["done"] == 8
+    assert not any((workdir / full_run.IN_TRAINING).iterdir())  # the training state goes with the record
 
 
 def test_bad_criterion_and_deadline(tmp_path):

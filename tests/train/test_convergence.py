@@ -1,5 +1,6 @@
 """The convergence criterion of issue 30's run, and one model trained by it on the smoke data."""
 
+import jax
 import numpy as np
 import pytest
 
@@ -44,3 +45,49 @@ def test_train_until_converged(smoke, improvement, budget, converged):
     assert learning_rate == pytest.approx(TINY_SMOKE.learning_rate * criterion.final_lr_fraction, rel=1e-5)
     assert model.validation[-1][1:] == pytest.approx(
         convergence.validation_errors(model.model, model.state, validation, 64))
+
+
+class _Interrupted(Exception):
+    pass
+
+
+def test_a_resumed_model_ends_as_an_uninterrupted_one(smoke, tmp_path, monkeypatch):
+    examples, validation = smoke["train"], smoke["validation"]
+    spec = ModelSpec("size=64/seed=1", np.arange(64), seed=1)
+    criterion = convergence.Criterion(eval_every=5, window=2, min_improvement=0.0, base_steps=15,
+                                      steps_per_example=0.0, max_steps=15, min_decay_steps=7)
+    whole = convergence.train_until_converged(TINY_SMOKE, examples, spec, validation, criterion)
+    folder = tmp_path / "resume"
+
+    def killed_at_the_second_score(line, seen=[]):
+        seen.append(line)
+        if len(seen) == 2:
+            raise _Interrupted(line)
+
+    # Killed while scoring step 10: the state saved at step 5 is where it resumes.
+    with pytest.raises(_Interrupted):
+        convergence.train_until_converged(TINY_SMOKE, examples, spec, validation, criterion,
+                                          log=killed_at_the_second_score, resume_dir=folder)
+    assert convergence.resumed_step(folder) == 5
+    # Killed in the decay (15 constant steps, 7 of decay) before its step 21: saved at 20.
+    batch_indices = convergence.batch_indices
+
+    def killed_at_step_21(model_spec, step, batch_size):
+        if step == 21:
+            raise _Interrupted(step)
+        return batch_indices(model_spec, step, batch_size)
+
+    monkeypatch.setattr(convergence, "batch_indices", killed_at_step_21)
+    with pytest.raises(_Interrupted):
+        convergence.train_until_converged(TINY_SMOKE, examples, spec, validation, criterion, resume_dir=folder)
+    assert convergence.resumed_step(folder) == 20
+    monkeypatch.setattr(convergence, "batch_indices", batch_indices)
+    lines = []
+    resumed = convergence.train_until_converged(TINY_SMOKE, examples, spec, validation, criterion, log=lines.append,
+                                                resume_dir=folder)
+    assert len(lines) == 1 and "step 22 (after the decay)" in lines[0]
+    assert (resumed.converged, resumed.constant_steps, resumed.decay_steps) == (False, 15, 7)
+    assert resumed.validation == whole.validation
+    for got, expected in zip(jax.tree.leaves(resumed.state), jax.tree.leaves(whole.state), strict=True):
+        np.testing.assert_array_equal(got, expected)
+    assert convergence.resumed_step(tmp_path / "nothing") == 0
