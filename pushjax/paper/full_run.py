@@ -146,8 +146,11 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Mappin
     (model_spec,) = train_lib.subset_specs(count, (size,), (unit.seed,))
     config = train_config(spec, unit)
     started = datetime.datetime.now(datetime.timezone.utc)
+    resumed = convergence.resumed_step(resume_dir)
+    if resumed and log is not None:
+        log(f"{NAME}: {unit.key} continues from step {resumed}")
     tensorboard = (None if tensorboard_dir is None else train_lib.metrics_log.TensorBoardLog(
-        tensorboard_dir, [unit.key], "train", first_step=convergence.resumed_step(resume_dir)))
+        tensorboard_dir, [unit.key], "train", first_step=resumed))
     try:
         trained = convergence.train_until_converged(config, train_examples, model_spec, validation, criterion, log=log,
                                                     tensorboard=tensorboard, resume_dir=resume_dir)
@@ -244,8 +247,6 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
             log(f"{NAME}: training {unit.key} (budget {criterion.budget(min(unit.size, len(train_examples['motion'])))}"
                 " constant-rate steps)")
             resume_dir = workdir / IN_TRAINING / unit.key
-            if (resumed := convergence.resumed_step(resume_dir)):
-                log(f"{NAME}: {unit.key} continues from step {resumed}")
             record = train_unit(spec, unit, train_examples, validation, test, criterion, log,
                                 workdir / train_lib.metrics_log.TENSORBOARD_DIR, workdir / CHECKPOINTS / unit.key,
                                 resume_dir)
