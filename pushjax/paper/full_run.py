@@ -1,4 +1,4 @@
-"""Table 1 at the paper's composition and sizes (issue 30): one model at a time, each recorded as it finishes.
+"""Table 1 at the paper's composition and sizes (issue 30): one model per unit, each recorded as it finishes.
 
 The run ``data_efficiency_full`` trains on the ``data_efficiency`` dataset at ``cpu_full`` scale (all objects on all
 four surfaces at 20 mm/s, 190 080 training and 38 016 test examples from 528 test sequences, 64 x 64 images):
@@ -8,7 +8,8 @@ batch order), and `WIDE_VARIANTS` once at the paper's widths at the full split. 
 criterion of `pushjax.train.convergence` (constant rate until its validation score stops improving, within a budget
 growing with the size, then a short decay).
 
-A unit of work is one model. When it is trained and evaluated, its record -- the test row of ``results.json``
+A unit of work is one model; `run` trains them in order, one or a few at once (threads sharing the training split; a
+model's record does not depend on how many). When it is trained and evaluated, its record -- the test row of ``results.json``
 (per-sequence sums included, for the bootstrap), the criterion's verdict, its steps and validation curve -- is written
 to ``<workdir>/models/<key>.json`` (a few tens of KiB), and ``results.json``, ``results.md`` and the figures are
 assembled again from every record present. A later run with the same work directory skips every model that has a
@@ -27,6 +28,7 @@ import datetime
 import json
 import math
 import shutil
+import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -209,7 +211,8 @@ def assemble(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence
 def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit], *,
         max_models: int | None = None, deadline: datetime.datetime | None = None,
         criterion: convergence.Criterion = convergence.CRITERION, progress: bool = True,
-        publish: Callable[[dict], None] | None = None, log: Callable[[str], None] = print) -> dict:
+        publish: Callable[[dict], None] | None = None, log: Callable[[str], None] = print,
+        models_at_once: int = 1) -> dict:
     """Trains the `units` that have no record in `workdir`, in order, writing each record when it is done.
 
     Args:
@@ -223,7 +226,13 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
       progress: progress bars of the dataset build.
       publish: called with ``results.json``'s contents after it is written (e.g. tables and figures).
       log: progress lines.
+      models_at_once: models trained at the same time, each in its own thread on the one copy of the training split
+        (the next unit in order goes to the first thread that is free). A model's parameters and record do not
+        depend on it; on 2 CPU cores two models at once train 1.2-1.4x the model-steps per second of one
+        (BENCHMARKS.md), while each record's ``train_seconds`` and ``steps_per_second`` count the shared cores.
     """
+    if models_at_once < 1:
+        raise ValueError(f"models_at_once: expected at least 1, got {models_at_once}")
     workdir = Path(workdir)
     fields = spec.example_fields()
     splits = runner.load_splits(spec, spec.dataset, progress)
@@ -232,38 +241,97 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
         _write_json(workdir / "baselines.json", _compact(baseline_rows(spec, test)))
     todo = [unit for unit in units if unit.key not in records(workdir)]
     log(f"{NAME}: {len(units) - len(todo)} of {len(units)} models recorded in {workdir}/models, {len(todo)} to train")
-    trained = 0
     if todo and (max_models is None or max_models > 0):
         validation = train_lib.examples_from_source(splits["validation"], fields)
         clock = time.monotonic()
         train_examples = train_lib.examples_from_source(splits["train"], fields)
         log(f"{NAME}: read {len(train_examples['motion'])} training examples in {time.monotonic() - clock:.0f} s")
-        for unit in todo:
-            if max_models is not None and trained >= max_models:
-                break
-            if deadline is not None and datetime.datetime.now(datetime.timezone.utc) >= deadline:
-                log(f"{NAME}: deadline {deadline.isoformat(timespec='minutes')} passed; stopping before {unit.key}")
-                break
-            log(f"{NAME}: training {unit.key} (budget {criterion.budget(min(unit.size, len(train_examples['motion'])))}"
-                " constant-rate steps)")
-            resume_dir = workdir / IN_TRAINING / unit.key
-            record = train_unit(spec, unit, train_examples, validation, test, criterion, log,
-                                workdir / train_lib.metrics_log.TENSORBOARD_DIR, workdir / CHECKPOINTS / unit.key,
-                                resume_dir)
-            _write_json(workdir / "models" / f"{unit.key}.json", record)
-            shutil.rmtree(resume_dir)
-            trained += 1
-            row = record["row"]
-            log(f"{NAME}: recorded {unit.key}: {row['steps']} steps ({'converged' if row['converged'] else 'budget'}"
-                f"), test trans {row['trans_percent']:.1f} % rot {row['rot_percent']:.1f} %, "
-                f"{record['train_seconds']:.0f} s at {record['steps_per_second']:.1f} steps/s")
-            results = write_results(spec, workdir, units, criterion)
-            if publish is not None:
-                publish(results)
+        queue = _UnitQueue(todo, max_models, deadline, log)
+        written = threading.Lock()
+
+        def train_queued() -> None:
+            while (unit := queue.next()) is not None:
+                log(f"{NAME}: training {unit.key} (budget "
+                    f"{criterion.budget(min(unit.size, len(train_examples['motion'])))} constant-rate steps)")
+                try:
+                    record = train_unit(spec, unit, train_examples, validation, test, criterion,
+                                        lambda line, key=unit.key: log(f"[{key}] {line}"),
+                                        workdir / train_lib.metrics_log.TENSORBOARD_DIR,
+                                        workdir / CHECKPOINTS / unit.key, workdir / IN_TRAINING / unit.key)
+                except BaseException:
+                    queue.stop()  # no thread starts another model
+                    raise
+                with written:
+                    _write_json(workdir / "models" / f"{unit.key}.json", record)
+                    shutil.rmtree(workdir / IN_TRAINING / unit.key)
+                    row = record["row"]
+                    log(f"{NAME}: recorded {unit.key}: {row['steps']} steps "
+                        f"({'converged' if row['converged'] else 'budget'}), test trans {row['trans_percent']:.1f} % "
+                        f"rot {row['rot_percent']:.1f} %, {record['train_seconds']:.0f} s at "
+                        f"{record['steps_per_second']:.1f} steps/s")
+                    results = write_results(spec, workdir, units, criterion)
+                    if publish is not None:
+                        publish(results)
+
+        _in_threads(train_queued, models_at_once)
     results = write_results(spec, workdir, units, criterion)
     if publish is not None:
         publish(results)
     return results
+
+
+class _UnitQueue:
+    """The units still to train, handed out in order to the threads of `run` until `max_models` have started, the
+    `deadline` has passed or a thread failed."""
+
+    def __init__(self, todo: Sequence[Unit], max_models: int | None, deadline: datetime.datetime | None,
+                 log: Callable[[str], None]):
+        self._todo, self._max_models, self._deadline, self._log = list(todo), max_models, deadline, log
+        self._started, self._stopped, self._lock = 0, False, threading.Lock()
+
+    def next(self) -> Unit | None:
+        with self._lock:
+            if self._stopped or self._started == len(self._todo):
+                return None
+            unit = self._todo[self._started]
+            if self._max_models is not None and self._started >= self._max_models:
+                self._stopped = True
+                return None
+            if self._deadline is not None and datetime.datetime.now(datetime.timezone.utc) >= self._deadline:
+                self._log(f"{NAME}: deadline {self._deadline.isoformat(timespec='minutes')} passed; stopping before "
+                          f"{unit.key}")
+                self._stopped = True
+                return None
+            self._started += 1
+            return unit
+
+    def stop(self) -> None:
+        with self._lock:
+            self._stopped = True
+
+
+def _in_threads(work: Callable[[], None], count: int) -> None:
+    """Runs `work` in `count` threads (in this one when `count` is 1) and re-raises the first error of any of them as
+    soon as it happens. The threads are daemons: an interrupted or failed run exits without waiting for the other
+    models being trained (their training state is saved every `convergence.Criterion.eval_every` steps)."""
+    if count == 1:
+        work()
+        return
+    errors: list[BaseException] = []
+
+    def guarded() -> None:
+        try:
+            work()
+        except BaseException as error:  # re-raised in the calling thread
+            errors.append(error)
+
+    threads = [threading.Thread(target=guarded, daemon=True, name=f"{NAME}-{index}") for index in range(count)]
+    for thread in threads:
+        thread.start()
+    while not errors and any(thread.is_alive() for thread in threads):
+        time.sleep(0.5)
+    if errors:
+        raise errors[0]
 
 
 def write_results(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit],

@@ -1,5 +1,6 @@
 """The paper-composition run (issue 30) on the smoke data: one model per unit, records, resuming."""
 
+import datetime
 import json
 import shutil
 import types
@@ -46,25 +47,44 @@ def test_results_of_the_records(smoke_results):
 
 
 def test_a_fresh_checkout_trains_only_the_missing_models(smoke_results, smoke_data, tmp_path):
+    # The smoke run trained two models at once (the binary's default); these two are trained again one at a time and
+    # must give the same records.
     workdir = tmp_path / "run"
     shutil.copytree(smoke_results("data_efficiency_full"), workdir)
     records = workdir / "models"
     before = {path.name: path.read_text() for path in records.iterdir()}
-    (records / "hybrid_80_seed0.json").unlink()
+    missing = ["hybrid_80_seed0", "neural_80_seed0"]
+    for key in missing:
+        (records / f"{key}.json").unlink()
     (workdir / "results.json").unlink()
     _, arguments = RUNS["data_efficiency_full"]
     run_binary("data_efficiency_full", *SMOKE, f"--data_dir={smoke_data('data_efficiency')}", f"--workdir={workdir}",
                *arguments, "--max_models=0")
     results = json.loads((workdir / "results.json").read_text())
-    assert results["progress"]["missing"] == ["hybrid_80_seed0"]
+    assert sorted(results["progress"]["missing"]) == missing
     run_binary("data_efficiency_full", *SMOKE, f"--data_dir={smoke_data('data_efficiency')}", f"--workdir={workdir}",
-               *arguments)
+               *arguments, "--models_at_once=1")
     after = {path.name: path.read_text() for path in records.iterdir()}
     assert set(after) == set(before)
-    assert all(after[name] == text for name, text in before.items() if name != "hybrid_80_seed0.json")
-    assert json.loads(after["hybrid_80_seed0.json"])["row"] == json.loads(before["hybrid_80_seed0.json"])["row"]
+    assert all(after[name] == text for name, text in before.items() if name[:-len(".json")] not in missing)
+    for key in missing:
+        retrained, original = (json.loads(texts[f"{key}.json"]) for texts in (after, before))
+        assert retrained["row"] == original["row"] and retrained["validation"] == original["validation"]
     assert json.loads((workdir / "results.json").read_text())["progress"]["done"] == 8
     assert not any((workdir / full_run.IN_TRAINING).iterdir())  # the training state goes with the record
+
+
+def test_the_queue_hands_out_units_in_order_until_the_limit_or_the_deadline():
+    units = full_run.plan(sizes=(40, 80), seeds=(0,), side_sizes=(), wide=False)
+    lines = []
+    queue = full_run._UnitQueue(units, 2, None, lines.append)
+    assert [queue.next(), queue.next(), queue.next(), queue.next()] == [units[0], units[1], None, None]
+    past = datetime.datetime(2000, 1, 1, tzinfo=datetime.timezone.utc)
+    queue = full_run._UnitQueue(units, None, past, lines.append)
+    assert queue.next() is None and queue.next() is None and len(lines) == 1 and units[0].key in lines[0]
+    queue = full_run._UnitQueue(units, None, None, lines.append)
+    queue.stop()
+    assert queue.next() is None
 
 
 def test_bad_criterion_and_deadline(tmp_path):
