@@ -5,14 +5,18 @@ One model of each variant of the run (and neural / hybrid at the paper's widths)
 of ``--data_dir``'s ``data_efficiency`` dataset at ``--scale`` (the smoke dataset has the same image and glimpse
 size as ``cpu_full``). Per variant: the steady-state seconds per step (after `--warmup` steps), split into the input
 handling (drawing the batch's indices and gathering its arrays, `pushjax.train.batching`) and the jitted step; and
-the evaluation speed (examples per second of `pushjax.train.evaluate.predict`).
+the evaluation speed (examples per second of `pushjax.train.evaluate.predict`). With ``--at_once=N``, a second table:
+N models of each variant (seeds 0..N-1) trained one after the other and then at the same time in N threads, as
+``experiments.data_efficiency_full --models_at_once=N`` trains them, in model-steps per second, and whether the
+threads' parameters equal the sequential ones.
 
-    python benchmarks/full_throughput.py [--data_dir=/tmp/pushjax_bench_data] [--scale=smoke] [--steps=200]
+    python benchmarks/full_throughput.py [--data_dir=/tmp/pushjax_bench_data] [--scale=smoke] [--steps=200] [--at_once=2]
 """
 
 import dataclasses
 import os
 import tempfile
+import threading
 import time
 
 import jax
@@ -32,6 +36,8 @@ _DATA_DIR = flags.DEFINE_string("data_dir", os.path.join(tempfile.gettempdir(), 
 _SCALE = flags.DEFINE_string("scale", "smoke", "Scale of the data_efficiency dataset read.")
 _STEPS = flags.DEFINE_integer("steps", 200, "Timed steps per variant.", lower_bound=10)
 _WARMUP = flags.DEFINE_integer("warmup", 20, "Steps before timing (compilation).", lower_bound=1)
+_AT_ONCE = flags.DEFINE_integer("at_once", 1, "Also time this many models trained at once in threads (1: not).",
+                                lower_bound=1)
 _VARIANTS = flags.DEFINE_list("variants", ["neural", "hybrid", "error", "simple", "neural_dyn", "neural_wide",
                                            "hybrid_wide"], "Variants (``_wide``: the paper's widths).")
 
@@ -77,6 +83,47 @@ def main(argv):
         parameters = sum(np.size(leaf) for leaf in jax.tree.leaves(state.params))
         print(f"| {name} | {parameters:,} | {input_s * 1e3:.2f} | {step_s * 1e3:.1f} | "
               f"{1.0 / (input_s + step_s):.1f} | {input_s / (input_s + step_s):.1%} | {eval_rate:.0f} |", flush=True)
+
+    if _AT_ONCE.value > 1:
+        _time_models_at_once(splits, base, _AT_ONCE.value)
+
+
+def _time_models_at_once(splits, base, count: int) -> None:
+    print(f"\n| variant | one at a time, model-steps/s | {count} at once, model-steps/s | speed-up | same parameters |")
+    print("|---|---:|---:|---:|---|")
+    for name in _VARIANTS.value:
+        if name.endswith("_wide"):
+            continue
+        config = base.with_variant(name)
+        fields = model_fields(config.model)
+        examples = train.examples_from_source(splits["train"], fields)
+        model = PushModel(config.model)
+        optimizer = optax.inject_hyperparams(optax.adam)(learning_rate=1e-3)
+        step_fn = jax.jit(make_train_step(model, optimizer, config.weight_decay))
+
+        def train_model(seed, steps, out):
+            spec = ModelSpec("bench", np.arange(len(examples["motion"])), seed=seed)
+            state = create_train_state(model, optimizer, gather(examples, batch_indices(spec, 0, 32), fields), seed)
+            for step in range(steps):
+                state, _ = step_fn(state, gather(examples, batch_indices(spec, step, 32), fields))
+            out[seed] = jax.device_get(state.params)
+
+        train_model(count, _WARMUP.value, {})  # compilation
+        sequential, threaded = {}, {}
+        clock = time.perf_counter()
+        for seed in range(count):
+            train_model(seed, _STEPS.value, sequential)
+        one_rate = count * _STEPS.value / (time.perf_counter() - clock)
+        threads = [threading.Thread(target=train_model, args=(seed, _STEPS.value, threaded)) for seed in range(count)]
+        clock = time.perf_counter()
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        many_rate = count * _STEPS.value / (time.perf_counter() - clock)
+        same = all(np.array_equal(a, b) for seed in range(count)
+                   for a, b in zip(jax.tree.leaves(sequential[seed]), jax.tree.leaves(threaded[seed])))
+        print(f"| {name} | {one_rate:.1f} | {many_rate:.1f} | {many_rate / one_rate:.2f}x | {same} |", flush=True)
 
 
 if __name__ == "__main__":
