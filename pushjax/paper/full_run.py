@@ -150,7 +150,7 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Mappin
     started = datetime.datetime.now(datetime.timezone.utc)
     resumed = convergence.resumed_step(resume_dir)
     if resumed and log is not None:
-        log(f"{NAME}: {unit.key} continues from step {resumed}")
+        log(f"continues from step {resumed}")
     tensorboard = (None if tensorboard_dir is None else train_lib.metrics_log.TensorBoardLog(
         tensorboard_dir, [unit.key], "train", first_step=resumed))
     try:
@@ -233,6 +233,7 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
     """
     if models_at_once < 1:
         raise ValueError(f"models_at_once: expected at least 1, got {models_at_once}")
+    log = _one_line_at_a_time(log)
     workdir = Path(workdir)
     fields = spec.example_fields()
     splits = runner.load_splits(spec, spec.dataset, progress)
@@ -308,6 +309,17 @@ class _UnitQueue:
     def stop(self) -> None:
         with self._lock:
             self._stopped = True
+
+
+def _one_line_at_a_time(log: Callable[[str], None]) -> Callable[[str], None]:
+    """`log` for several threads: one line at a time (``print`` from two threads can run their lines together)."""
+    lock = threading.Lock()
+
+    def locked(line: str) -> None:
+        with lock:
+            log(line)
+
+    return locked
 
 
 def _in_threads(work: Callable[[], None], count: int) -> None:
