@@ -242,9 +242,12 @@ def _masks(candidates: Sequence[Sequence[str]], exact: bool) -> np.ndarray:
     return np.array([[name in candidate for name in _family_names(exact)] for candidate in candidates], np.float32)
 
 
-def _slots(count: int, family_size: int) -> int:
-    """Candidates are padded to a power of two up to the family's size: few compiled programs over the rounds of
-    selection, and no exact limit surface solved for many padding slots when one candidate needs it."""
+def _slots(count: int, family_size: int, exact: bool) -> int:
+    """The candidate slots of one compiled fit: the ellipsoidal family's always its full size (its model is cheap, and
+    each other count compiled its own program: 8-10 s each), the exact surface's a power of two up to the family's
+    size (no exact limit surface solved for many padding slots when one candidate needs it)."""
+    if not exact:
+        return max(count, family_size)
     return max(count, min(family_size, 1 << max(count - 1, 0).bit_length()))
 
 
@@ -286,7 +289,7 @@ def fit_effects(
         if not members:
             continue
         names = _family_names(exact)
-        slots = _slots(len(members), len(names))
+        slots = _slots(len(members), len(names), exact)
         group = [candidates[k] for k in members]
         masks = _masks(group + [()] * (slots - len(group)), exact)
         starts = []
@@ -316,9 +319,10 @@ def fit_effects(
 
 
 def _physical_with_std(scaled, mask, batch, scales, floors, sequence, candidate, exact):
-    residual, jacobian = jax.device_get(_residual_jacobian(scaled, jnp.asarray(mask), batch.inputs, batch.target,
-                                                           scales, jnp.asarray(_own_variables(scaled, candidate)),
-                                                           exact))
+    own = jnp.asarray(_own_variables(scaled, candidate))
+    residual, jacobian = jax.device_get(_in_chunks(
+        lambda inputs, target: _residual_jacobian(scaled, jnp.asarray(mask), inputs, target, scales, own, exact),
+        batch.inputs, batch.target))
     floors = np.asarray(floors, np.float64)
     used = sequence >= 0
     residual, jacobian, sequence = residual[used].astype(np.float64), jacobian[used].astype(np.float64), sequence[used]
@@ -356,28 +360,30 @@ def _physical_with_std(scaled, mask, batch, scales, floors, sequence, candidate,
 
 
 @functools.partial(jax.jit, static_argnames="exact")
-def _predict_many(scaled, masks, inputs, exact):
-    return jax.vmap(lambda s, m: _FULL_MODELS[exact](_params_from_scaled(s, m, exact), inputs))(scaled, masks)
+def _predict_one(scaled, inputs, exact):
+    return _FULL_MODELS[exact](_params_from_scaled(scaled, jnp.ones(len(_family_names(exact))), exact), inputs)
+
+
+def _in_chunks(function, *trees):
+    """``function(*trees)`` for trees of [P, ...] arrays of a padded batch (P a multiple of :data:`MIN_PADDED_SIZE`),
+    computed :data:`MIN_PADDED_SIZE` windows at a time: a window's value depends on its own inputs only, and one chunk
+    size compiles one program for every batch size (each size compiled its own, 2-5 s)."""
+    size = len(jax.tree.leaves(trees[0])[0])
+    chunks = [function(*jax.tree.map(lambda leaf: leaf[start:start + MIN_PADDED_SIZE], trees))
+              for start in range(0, size, MIN_PADDED_SIZE)]
+    return jax.tree.map(lambda *parts: jnp.concatenate(parts), *chunks)
 
 
 def predict(results: Sequence[FitResult | None], examples: Examples) -> np.ndarray:
     """[M, N, 3] predictions on ``examples`` of fitted models (None: the plain Lynch model)."""
     batch = to_batch(examples)
     prediction = np.zeros((len(results), batch.count, 3))
-    for exact in (False, True):
-        members = [k for k, result in enumerate(results)
-                   if (result is not None and is_exact(result.effects)) == exact]
-        if not members:
-            continue
-        names = _family_names(exact)
-        slots = _slots(len(members), len(names))
-        params = []
-        for k in members + [None] * (slots - len(members)):
-            full = effects_lib.init_params(names)
-            for name, values in (results[k].params if k is not None and results[k] is not None else {}).items():
-                full[name] = {key: jnp.asarray(value, jnp.float32) for key, value in values.items()}
-            params.append(_scaled_from_params(full))
-        masks = jnp.ones((slots, len(names)), jnp.float32)
-        many = _predict_many(_stack(params), masks, batch.inputs, exact)
-        prediction[members] = np.asarray(many, np.float64)[:len(members), :batch.count]
+    for k, result in enumerate(results):
+        exact = result is not None and is_exact(result.effects)
+        full = effects_lib.init_params(_family_names(exact))
+        for name, values in (result.params if result is not None else {}).items():
+            full[name] = {key: jnp.asarray(value, jnp.float32) for key, value in values.items()}
+        scaled = _scaled_from_params(full)
+        prediction[k] = np.asarray(_in_chunks(lambda inputs: _predict_one(scaled, inputs, exact), batch.inputs),
+                                   np.float64)[:batch.count]
     return prediction
