@@ -9,6 +9,7 @@ import pytest
 from pushjax.loop import correction, fit, hierarchy, metrics, select, splits
 from pushjax.loop.windows import build_examples, split_by_sequence
 from pushjax.mit.files import iter_pushes
+from pushjax.physics import effects as effects_lib
 from pushjax.physics.effects import EFFECT_NAMES
 
 from .conftest import FIT, STRIDE
@@ -126,3 +127,12 @@ def test_an_effect_whose_parameters_flip_between_surfaces_is_a_knob(record):
     # One surface, one object, one velocity: nothing to compare, so the check cannot call it a knob.
     single = select.check_mechanism(examples, ("pusher_friction",), "pusher_friction", settings, start)
     assert single.p_value is None and not single.is_knob(0.05)
+
+
+def test_predictions_in_chunks_equal_the_model_on_every_window(synthetic):
+    # More windows than one chunk of fit.MIN_PADDED_SIZE: the chunked predictions (and the padding) must line up.
+    assert len(synthetic) > 2 * fit.MIN_PADDED_SIZE
+    exact = fit.FitResult(effects=("limit_surface",), params=effects_lib.init_params(("limit_surface",)), loss=0.0)
+    for result in (fit.FitResult(effects=tuple(TRUE), params=TRUE, loss=0.0), exact):
+        direct = effects_lib.compose(result.effects)(result.params, synthetic.inputs)
+        np.testing.assert_allclose(fit.predict([result], synthetic)[0], direct, rtol=1e-5, atol=1e-7)
