@@ -15,8 +15,9 @@ to ``<workdir>/models/<key>.json`` (a few tens of KiB), and ``results.json``, ``
 assembled again from every record present. A later run with the same work directory skips every model that has a
 record, so the run resumes across sittings and fresh checkouts as long as the records are kept (committed); a
 model interrupted before its record is written continues from its training state, saved every 1 000 steps to
-``<workdir>/in_training/<key>/`` (`pushjax.train.convergence`, not committed; removed once the record is written), to
-the same parameters and record as without the interruption. The dataset is rebuilt from its
+``<workdir>/in_training/<key>/`` (`pushjax.train.convergence`; removed once the record is written), to the same
+parameters and record as without the interruption. Commit that folder with the records when a sitting ends (a few
+hundred KiB per model, a few MiB for the wide ones) and a fresh checkout continues those models too. The dataset is rebuilt from its
 seed when missing. Each trained model's parameters go to ``<workdir>/checkpoints/<key>/`` (not committed), from which
 ``pushjax.load_model(workdir, model=key)`` loads it to predict; models recorded before the run kept them have none.
 """
