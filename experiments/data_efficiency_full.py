@@ -10,7 +10,7 @@ Without --scale, --sizes and --seeds: cpu_full, the sizes above and seeds 0, 1 a
 Trains every model of `pushjax.paper.full_run.plan` that has no record in ``<workdir>/models/`` (neural, hybrid and
 error at every size, simple and neural_dyn at 2 500, 20 000 and the full split, 3 seeds, neural and hybrid at the
 paper's widths once), each by the convergence criterion of `pushjax.train.convergence`, and writes each model's record
-as it finishes (--models_at_once of them at the same time, in threads: on 2 cores two train 1.2-1.4x the steps per
+as it finishes (--models_at_once of them at the same time, in threads: on 2 cores two train 1.15-1.4x the steps per
 second of one, and a model's record does not depend on it); then results.json, results.md and the figures from every record. Keep (commit) the records and a
 later call resumes with the models still missing; the dataset is built from its seed when it is missing.
 """

@@ -229,7 +229,7 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
       log: progress lines.
       models_at_once: models trained at the same time, each in its own thread on the one copy of the training split
         (the next unit in order goes to the first thread that is free). A model's parameters and record do not
-        depend on it; on 2 CPU cores two models at once train 1.2-1.4x the model-steps per second of one
+        depend on it; on 2 CPU cores two models at once train 1.15-1.4x the model-steps per second of one
         (BENCHMARKS.md), while each record's ``train_seconds`` and ``steps_per_second`` count the shared cores.
     """
     if models_at_once < 1:
