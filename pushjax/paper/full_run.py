@@ -97,7 +97,7 @@ def setup(sizes: Sequence[int] = SIZES) -> spec_lib.Setup:
 
 def make_spec(data_dir: str | None = None, *, sizes: Sequence[int] = SIZES, seeds: Sequence[int] = SEEDS,
               scale: str = SCALE, build: bool = True, workers: int | None = None) -> spec_lib.ExperimentSpec:
-    """The run's `ExperimentSpec` (``sequential`` mode: one model at a time on the CPU)."""
+    """The run's `ExperimentSpec` (``sequential`` mode: each model is trained on its own, not stacked with others)."""
     return spec_lib.make_spec(setup(sizes), scale, sizes=sizes, seeds=seeds, data_dir=data_dir, build=build,
                               workers=workers, mode="sequential")
 
