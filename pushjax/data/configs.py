@@ -49,6 +49,10 @@ Scales:
     sequence, 64 x 64 images and 20 x 20 px glimpses. ``data_efficiency``: 2 640 training sequences (190 080
     examples), 528 test sequences (38 016 examples) and 88 validation sequences (6 336 examples), as the paper's
     191 k / 38 k.
+``paper_full``
+    ``cpu_full``'s pushes, splits and examples (the same seeds draw the same pushes, windows and transforms) rendered at
+    the paper's 128 x 128 px with 80 x 80 px glimpses: the paper's composition at the paper's images, for a GPU
+    (issue 30, part 4).
 ``paper``
     The paper's sizes: ``data_efficiency`` 191 k / 38 k, ``new_pushes`` about 114 k / 23 k / 91 k,
     ``objects`` 35 k per training set, ``viewpoint`` 191 k / 38 k, ``repeated`` 200; 128 x 128 images and
@@ -81,7 +85,7 @@ from pushjax.sim.surfaces import SURFACE_NAMES
 from pushjax.sim.testbed import DEFAULT_PROFILE, PROFILES, Testbed
 
 EXPERIMENTS = ("data_efficiency", "new_pushes", "velocities", "objects", "viewpoint", "repeated")
-SCALES = ("smoke", "cpu", "cpu_full", "paper")
+SCALES = ("smoke", "cpu", "cpu_full", "paper_full", "paper")
 DEFAULT_SCALE = "cpu"
 
 TRAIN_VELOCITY = 20.0
@@ -203,6 +207,8 @@ _SIZES = {
                 image_size=64, glimpse_size=20),
     "cpu_full": dict(pushes_per_object=66, test_pushes_per_object=8, windows_per_sequence=24,
                      transforms_per_window=3, image_size=64, glimpse_size=20, surfaces=SURFACE_NAMES),
+    "paper_full": dict(pushes_per_object=66, test_pushes_per_object=8, windows_per_sequence=24,
+                       transforms_per_window=3, image_size=128, glimpse_size=80, surfaces=SURFACE_NAMES),
     "paper": dict(pushes_per_object=290, test_pushes_per_object=48, windows_per_sequence=24,
                   transforms_per_window=3, image_size=128, glimpse_size=80),
 }

@@ -143,24 +143,29 @@ def gather(examples: Examples, indices: np.ndarray, fields: Sequence[str]) -> di
     return {name: examples[name][indices] for name in fields}
 
 
-def examples_from_source(source: Sequence[Mapping[str, Any]], fields: Sequence[str]) -> dict[str, np.ndarray]:
-    """All examples of a random-access source (e.g. a `pushjax.data.load` split) as in-memory arrays.
+def examples_from_source(source: Sequence[Mapping[str, Any]], fields: Sequence[str],
+                         indices: Sequence[int] | None = None) -> dict[str, np.ndarray]:
+    """The examples of a random-access source (e.g. a `pushjax.data.load` split) as in-memory arrays.
 
     Args:
       source: ``len`` and ``[i]`` (``__getitems__`` when present) giving dicts of arrays.
       fields: the fields to keep (e.g. `model_fields` plus `EVALUATION_FIELDS`); names of
         `pushjax.data.schema.FIELDS`.
+      indices: [N] indices of the examples to read, in the order of the result (None: all, in order).
 
     Returns:
-      {field: [N, ...] array} with the dtypes of `pushjax.data.schema.FIELDS`, N = len(source).
+      {field: [N, ...] array} with the dtypes of `pushjax.data.schema.FIELDS`, N = len(source) without `indices`.
     """
     count = len(source)
-    if count == 0:
-        raise ValueError("source: expected at least one example")
+    keys = np.arange(count) if indices is None else np.asarray(indices, dtype=np.int64)
+    if keys.size == 0:
+        raise ValueError("source: expected at least one example" if count == 0 else "indices: expected at least one")
+    if keys.min() < 0 or keys.max() >= count:
+        raise ValueError(f"indices: expected indices in [0, {count}), got {keys.min()}..{keys.max()}")
     read = getattr(source, "__getitems__", None) or (lambda keys: [source[key] for key in keys])
     chunks = {name: [] for name in fields}
-    for start in range(0, count, _READ_CHUNK):
-        for example in read(list(range(start, min(start + _READ_CHUNK, count)))):
+    for start in range(0, keys.size, _READ_CHUNK):
+        for example in read(keys[start:start + _READ_CHUNK].tolist()):
             for name in fields:
                 chunks[name].append(example[name])
     return {name: np.asarray(values, dtype=schema.FIELDS[name].dtype) for name, values in chunks.items()}

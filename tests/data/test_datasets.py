@@ -1,5 +1,6 @@
 """The TFDS push datasets at smoke scale: fields, composition, splits, determinism and physical consistency."""
 
+import dataclasses
 import filecmp
 import os
 import subprocess
@@ -304,3 +305,12 @@ def test_cpu_full_has_the_papers_composition():
     assert not test & set(plan.splits["train"]) and not test & set(plan.splits["validation"])
     # every surface in the test split
     assert {plan.jobs[i].params.surface for i in test} == {"abs", "delrin", "plywood", "pu"}
+
+
+def test_paper_full_has_cpu_fulls_pushes_at_the_papers_images():
+    cpu_full, paper_full = (configs.get_config("data_efficiency", scale) for scale in ("cpu_full", "paper_full"))
+    plans = [configs.plan_splits(config, "/unused") for config in (cpu_full, paper_full)]
+    assert plans[0].splits == plans[1].splits
+    assert [job.params for job in plans[0].jobs] == [job.params for job in plans[1].jobs]
+    assert (paper_full.image_size, paper_full.glimpse_size) == (128, 80)
+    assert dataclasses.replace(paper_full, scale="cpu_full", image_size=64, glimpse_size=20) == cpu_full

@@ -5,12 +5,14 @@ import json
 import shutil
 import types
 
+import numpy as np
 import pytest
 from absl import app
 
 from pushjax import train as train_lib
 from pushjax.paper import findings, full_run, runner
 from pushjax.train import evaluate
+from pushjax.train.batching import batch_indices, gather
 from pushjax.train.predictor import load_model
 from tests.paper.conftest import RUNS, SMOKE, run_binary
 
@@ -72,6 +74,23 @@ def test_a_fresh_checkout_trains_only_the_missing_models(smoke_results, smoke_da
         assert retrained["row"] == original["row"] and retrained["validation"] == original["validation"]
     assert json.loads((workdir / "results.json").read_text())["progress"]["done"] == 8
     assert not any((workdir / full_run.IN_TRAINING).iterdir())  # the training state goes with the record
+
+
+def test_models_read_only_their_rows_and_see_the_batches_of_the_whole_split():
+    split = {"l": np.arange(1000, dtype=np.float32), "motion": np.arange(3000, dtype=np.float32).reshape(1000, 3)}
+    source = [{name: values[index] for name, values in split.items()} for index in range(1000)]
+    units = [full_run.Unit("neural", 100, seed) for seed in (0, 1)] + [full_run.Unit("hybrid", 100, 0)]
+    training = full_run.read_training_examples(source, ["l", "motion"], units)
+    assert 100 < len(training.rows) <= 200 and training.split_size == 1000
+    for unit in units:
+        (whole,) = train_lib.subset_specs(1000, (unit.size,), (unit.seed,))
+        spec = training.model_spec(unit)
+        for step in (0, 3, 7):  # steps 3 and 7 cross into the next epoch of 100 examples
+            np.testing.assert_array_equal(
+                gather(training.examples, batch_indices(spec, step, 32), ["motion"])["motion"],
+                gather(split, batch_indices(whole, step, 32), ["motion"])["motion"])
+    everything = full_run.read_training_examples(source, ["l"], [full_run.Unit("neural", 5000, 0)])
+    np.testing.assert_array_equal(everything.rows, np.arange(1000))
 
 
 def test_the_queue_hands_out_units_in_order_until_the_limit_or_the_deadline():

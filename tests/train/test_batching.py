@@ -89,6 +89,15 @@ def test_examples_from_source_reads_every_example_with_the_schema_dtypes():
         train.examples_from_source(_Source(0), ["l"])
 
 
+def test_examples_from_source_reads_the_given_indices_in_their_order():
+    indices = [2400, 3, 1100, 5]
+    examples = train.examples_from_source(_Source(2500), ["l", "motion"], indices)
+    np.testing.assert_array_equal(examples["l"], indices)
+    np.testing.assert_array_equal(examples["motion"][:, 0], indices)
+    with pytest.raises(ValueError, match=r"indices: expected indices in \[0, 2500\)"):
+        train.examples_from_source(_Source(2500), ["l"], [2500])
+
+
 def test_examples_from_source_reads_a_smoke_split(smoke):
     examples = smoke["test"]
     assert {name: examples[name].dtype for name in train.MODEL_INPUT_FIELDS} == {

@@ -1,4 +1,5 @@
-"""Training configurations per scale (`pushjax.data.SCALES`): `smoke` (tests, seconds), `cpu` (a laptop), `paper`."""
+"""Training configurations per scale (`pushjax.data.SCALES`): `smoke` (tests, seconds), `cpu` (a laptop),
+`cpu_full` and `paper_full` (issue 30's run, trained by a convergence criterion), `paper`."""
 
 from __future__ import annotations
 
@@ -7,11 +8,12 @@ import typing
 from collections.abc import Callable, Mapping
 
 from pushjax.data.configs import DatasetConfig
-from pushjax.train.configs import cpu, cpu_full, paper, smoke
+from pushjax.train.configs import cpu, cpu_full, paper, paper_full, smoke
 from pushjax.train.configs.train_config import TrainConfig
 
 SCALE_CONFIGS: dict[str, Callable[[], TrainConfig]] = {
-    "smoke": smoke.get_config, "cpu": cpu.get_config, "cpu_full": cpu_full.get_config, "paper": paper.get_config}
+    "smoke": smoke.get_config, "cpu": cpu.get_config, "cpu_full": cpu_full.get_config,
+    "paper_full": paper_full.get_config, "paper": paper.get_config}
 """Scale (`pushjax.data.SCALES`) -> its config (``pushjax/train/configs/<scale>.py``)."""
 
 

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Issue 30, part 4: neural and hybrid at the paper's images on one GPU, inside a fixed time.
+#
+#   bash benchmarks/paper_full_gpu.sh OUT_DIR [SECONDS=480] [SIZE=20000]
+#
+# Builds data_efficiency at scale paper_full (cpu_full's pushes, splits and examples rendered at 128 x 128 px, 80 x 80
+# px glimpses; the build on the CPU cores with JAX kept off the GPU), then trains neural and hybrid at SIZE training
+# examples, seeds 0, 1 and 2, at the paper's widths by issue 30's convergence criterion
+# (experiments.data_efficiency_full --scale=paper_full): no model starts after three quarters of SECONDS, and training
+# stops at SECONDS. Writes OUT_DIR/build.log, OUT_DIR/train.log and OUT_DIR/records.tgz (the finished models'
+# records, results.json and results.md). Environment: PYTHON (default python3), DATA_DIR, WORKDIR (default under
+# /tmp); for a dry run on a CPU, SCALE (default paper_full) and ARGS (more flags of the training binary, e.g. a tiny
+# --criterion).
+set -uo pipefail
+out=${1:?usage: benchmarks/paper_full_gpu.sh OUT_DIR [SECONDS] [SIZE]}
+seconds=${2:-480}
+size=${3:-20000}
+python=${PYTHON:-python3}
+data=${DATA_DIR:-/tmp/pushjax_paper_full_data}
+work=${WORKDIR:-/tmp/pushjax_paper_full_run}
+scale=${SCALE:-paper_full}
+start=$(date +%s)
+mkdir -p "$out" "$data" "$work"
+since() { echo $(( $(date +%s) - start )); }
+
+nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader || true
+echo "cores $(nproc); $("$python" -c 'import jax; print("jax", jax.__version__, jax.devices())')"
+
+JAX_PLATFORMS=cpu "$python" -m experiments.build_dataset --experiment=data_efficiency --scale="$scale" \
+  --data_dir="$data" --workers="$(nproc)" > "$out/build.log" 2>&1
+status=$?
+echo "build: exit $status after $(since) s; $(du -sm "$data" | cut -f1) MiB in $data"
+tail -3 "$out/build.log"
+[ $status -eq 0 ] || exit $status
+
+deadline=$(date -u -d "@$(( start + seconds * 3 / 4 ))" +%Y-%m-%dT%H:%M:%S)
+timeout $(( seconds - $(since) )) "$python" -m experiments.data_efficiency_full --scale="$scale" --sizes="$size" \
+  --seeds=0,1,2 --nowide --max_models=6 --models_at_once=2 --deadline="$deadline" --workdir="$work" \
+  --data_dir="$data" ${ARGS:-} > "$out/train.log" 2>&1
+echo "training: exit $? after $(since) s"
+grep -E "read |recorded |steps/s" "$out/train.log" | grep -v "^\[" | tail -12
+(cd "$work" && tar czf "$out/records.tgz" models results.json results.md 2>/dev/null)
+ls -la "$out"
