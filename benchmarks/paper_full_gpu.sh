@@ -7,7 +7,8 @@
 # px glimpses; the build on the CPU cores with JAX kept off the GPU), then trains neural and hybrid at SIZE training
 # examples, seeds 0, 1 and 2, at the paper's widths by issue 30's convergence criterion
 # (experiments.data_efficiency_full --scale=paper_full): no model starts after three quarters of SECONDS, and training
-# stops at SECONDS. Writes OUT_DIR/build.log, OUT_DIR/train.log and OUT_DIR/records.tgz (the finished models'
+# stops at SECONDS. Models recorded in RECORDS (default results/data_efficiency_paper_full/models, the committed ones)
+# are not trained again. Writes OUT_DIR/build.log, OUT_DIR/train.log and OUT_DIR/records.tgz (the finished models'
 # records, results.json and results.md). Environment: PYTHON (default python3), DATA_DIR, WORKDIR (default under
 # /tmp); for a dry run on a CPU, SCALE (default paper_full) and ARGS (more flags of the training binary, e.g. a tiny
 # --criterion).
@@ -19,8 +20,10 @@ python=${PYTHON:-python3}
 data=${DATA_DIR:-/tmp/pushjax_paper_full_data}
 work=${WORKDIR:-/tmp/pushjax_paper_full_run}
 scale=${SCALE:-paper_full}
+records=${RECORDS:-results/data_efficiency_paper_full/models}
 start=$(date +%s)
-mkdir -p "$out" "$data" "$work"
+mkdir -p "$out" "$data" "$work/models"
+[ -d "$records" ] && cp -n "$records"/*.json "$work/models/" 2>/dev/null
 since() { echo $(( $(date +%s) - start )); }
 
 nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader || true
