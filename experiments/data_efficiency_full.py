@@ -1,10 +1,11 @@
 r"""Table 1 at the paper's composition and sizes, each model trained to convergence (issue 30).
 
   python -m experiments.data_efficiency_full --workdir=results/data_efficiency_full --data_dir=work/data \
-      [--scale=cpu_full] [--sizes=2500,5000,10000,20000,50000,100000,190080] [--seeds=0,1,2] [--nowide] \
+      [--scale=cpu_full|paper_full] [--sizes=2500,5000,10000,20000,50000,100000,190080] [--seeds=0,1,2] [--nowide] \
       [--max_models=N] [--deadline=2026-11-26T11:00] [--models_at_once=2] [--criterion=eval_every=1000;window=5]
 
-Without --scale, --sizes and --seeds: cpu_full, the sizes above and seeds 0, 1 and 2 (the shared flags of
+Without --scale, --sizes and --seeds: cpu_full, the sizes above and seeds 0, 1 and 2 (paper_full: the same pushes
+at the paper's images and widths, for a GPU: benchmarks/paper_full_gpu.sh) (the shared flags of
 `pushjax.paper.cli`; --variants, --num_steps, --mode and the multi-process flags are not used here).
 
 Trains every model of `pushjax.paper.full_run.plan` that has no record in ``<workdir>/models/`` (neural, hybrid and
