@@ -4,8 +4,8 @@ One :class:`PushEffects` builder (dataset name ``push_effects``) with a config p
 profile, named ``<experiment>_<scale>`` on the default ``realistic`` testbed and ``<experiment>_<scale>_ideal`` on
 the ``ideal`` one (see :mod:`pushjax.data.configs`). Building simulates the push sequences the config needs
 (MuJoCo testbed, :mod:`pushjax.sim`, with the config's profile) into a raw cache in the MIT layout, cuts them into
-examples (:mod:`pushjax.data.examples`) in worker processes (all cores by default) and writes one array_record
-file set per split::
+examples (:mod:`pushjax.data.examples`) and serialises them in worker processes (all cores by default), and writes
+one array_record file set per split::
 
     builder = PushEffects(config="data_efficiency_smoke", data_dir=DIR)      # seed=3 for another seed
     # config="data_efficiency_smoke_ideal": the same on the ideal testbed
@@ -46,6 +46,7 @@ from __future__ import annotations
 import collections
 import concurrent.futures
 import dataclasses
+import functools
 import multiprocessing
 import os
 import zlib
@@ -156,19 +157,12 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
 
     def _info(self) -> tfds.core.DatasetInfo:
         dataset = self.builder_config.dataset
-        sizes = {"H": dataset.image_size, "W": dataset.image_size}
-        features = tfds.features.FeaturesDict({
-            name: tfds.features.Tensor(
-                shape=tuple(sizes.get(dim, dim) for dim in field.shape), dtype=field.dtype, doc=field.doc,
-                # Images as raw bytes: the default float list serialises element by element (ms per image).
-                encoding=tfds.features.Encoding.BYTES if "H" in field.shape else tfds.features.Encoding.NONE)
-            for name, field in ALL_FIELDS.items()})
         return tfds.core.DatasetInfo(
             builder=self,
             description="Pushes in a MuJoCo stand-in for the MIT Push Dataset: depth image (or point cloud) "
                         "before the push, pusher position and motion, object motion over the horizon, and the "
                         "ground-truth physical state (Kloss, Schaal & Bohg).",
-            features=features,
+            features=example_features(dataset.image_size),
             # Stored in key order, as generated (not shuffled): the process pool and Beam write the same order.
             disable_shuffling=True,
             metadata=tfds.core.MetadataDict(config=dataclasses.asdict(dataset)),
@@ -200,20 +194,18 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
                 self._pool = None
 
     def _write_splits(self, dl_manager) -> list[tfds.core.SplitInfo]:
-        features = self.info.features
-        serializer = example_serializer.ExampleSerializer(features.get_serialized_info())
         infos = []
-        for split, examples in self._split_generators(dl_manager).items():
+        plan = self._checked_plan()
+        for split, ids in plan.splits.items():
             template = self._get_filename_template(split)
             shard_lengths, num_bytes, writer = [], 0, None
-            for _, example in examples:
+            for record in self._generate_examples(plan, ids, split):
                 if writer is None or shard_lengths[-1] == EXAMPLES_PER_SHARD:
                     if writer is not None:
                         writer.close()
                     shard_lengths.append(0)
                     writer = ArrayRecordWriter(os.fspath(_partial_shard(template, len(shard_lengths) - 1)),
                                                "group_size:1")
-                record = canonical_record(serializer.serialize_example(features.encode_example(example)))
                 writer.write(record)
                 shard_lengths[-1] += 1
                 num_bytes += len(record)
@@ -230,8 +222,8 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
     def _example_writer(self) -> tfds_writer.ExampleWriter:
         return _CanonicalExampleWriter(self.info.file_format)
 
-    def _split_generators(self, dl_manager, pipeline=None):
-        """Split name -> (key, example) iterator, or with a Beam ``pipeline`` (given by TFDS) a PCollection."""
+    def _checked_plan(self) -> configs.SplitPlan:
+        """The split plan; raises `IncompleteRawDirError` when a given raw folder lacks planned files."""
         plan = configs.plan_splits(self.builder_config.dataset, self._raw_dir)
         if not self._simulate_missing:
             missing = [job.path for job in plan.jobs if not job.path.is_file()]
@@ -240,12 +232,15 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
                     f"raw_dir: {len(missing)} of {len(plan.jobs)} files planned for {self.builder_config.name} "
                     f"are missing under {self._raw_dir} (first: {missing[0]}); a raw folder you give is read-only "
                     "to pushjax: add the files, or leave raw_dir out to simulate into pushjax's own cache")
-        if pipeline is not None:
-            return _beam_splits(pipeline, self.builder_config.dataset, plan, self._simulate_missing)
-        return {name: self._generate_examples(plan, ids, name) for name, ids in plan.splits.items()}
+        return plan
 
-    def _generate_examples(self, plan: configs.SplitPlan, ids: tuple[int, ...], split: str) -> Iterator:
-        """(key, example) of the split's sequences, in sequence order."""
+    def _split_generators(self, dl_manager, pipeline):
+        """Split name -> Beam PCollection of (key, example), for TFDS's Beam build (``pipeline`` given by TFDS)."""
+        return _beam_splits(pipeline, self.builder_config.dataset, self._checked_plan(), self._simulate_missing)
+
+    def _generate_examples(self, plan: configs.SplitPlan, ids: tuple[int, ...], split: str) -> Iterator[bytes]:
+        """(TFDS's hook, called by `_write_splits` only.) The stored records of the split's sequences, in key order,
+        serialised by the worker processes (`sequence_task`): this process only writes them."""
         dataset = self.builder_config.dataset
         tasks = [(dataset, plan.jobs[sequence_id], sequence_id, self._simulate_missing) for sequence_id in ids]
         if self._pool is None:
@@ -253,8 +248,8 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
         else:
             results = _ordered_map(self._pool, sequence_task, tasks, ahead=4 * self._workers)
         with tqdm.tqdm(total=len(tasks), disable=not self._progress, unit="seq", desc=f"{dataset.name} {split}") as bar:
-            for sequence_id, examples in zip(ids, results):
-                yield from keyed_examples(dataset, sequence_id, examples)
+            for records in results:
+                yield from records
                 bar.update()
 
 
@@ -375,8 +370,34 @@ def record_missing(job: PushJob, simulate_missing: bool) -> None:
         record_push(job)
 
 
-def sequence_task(task: tuple[configs.DatasetConfig, PushJob, int, bool]) -> dict[str, np.ndarray]:
-    """Worker: reads the sequence's raw file (recording it first if missing and allowed), returns its examples.
+def example_features(image_size: int) -> tfds.features.FeaturesDict:
+    """The features of one example: `ALL_FIELDS` with images of ``image_size`` x ``image_size`` px."""
+    sizes = {"H": image_size, "W": image_size}
+    return tfds.features.FeaturesDict({
+        name: tfds.features.Tensor(
+            shape=tuple(sizes.get(dim, dim) for dim in field.shape), dtype=field.dtype, doc=field.doc,
+            # Images as raw bytes: the default float list serialises element by element (ms per image).
+            encoding=tfds.features.Encoding.BYTES if "H" in field.shape else tfds.features.Encoding.NONE)
+        for name, field in ALL_FIELDS.items()})
+
+
+@functools.cache
+def _features_and_serializer(image_size: int) -> tuple[tfds.features.FeaturesDict, example_serializer.ExampleSerializer]:
+    features = example_features(image_size)
+    return features, example_serializer.ExampleSerializer(features.get_serialized_info())
+
+
+def example_records(dataset: configs.DatasetConfig, examples: dict[str, np.ndarray]) -> list[bytes]:
+    """The stored records (`canonical_record`) of a sequence's stacked examples (field -> [E, ...]), in order: the
+    same bytes in whichever process makes them."""
+    features, serializer = _features_and_serializer(dataset.image_size)
+    return [canonical_record(serializer.serialize_example(features.encode_example(
+        {name: value[index] for name, value in examples.items()}))) for index in range(dataset.examples_per_sequence)]
+
+
+def sequence_task(task: tuple[configs.DatasetConfig, PushJob, int, bool]) -> list[bytes]:
+    """Worker: reads the sequence's raw file (recording it first if missing and allowed), returns its examples'
+    records (`example_records`: serialised in the workers, the writing process only writes).
 
     Args:
       task: (dataset config, recording job, sequence id, whether a missing raw file may be simulated, i.e. the
@@ -387,7 +408,7 @@ def sequence_task(task: tuple[configs.DatasetConfig, PushJob, int, bool]) -> dic
     """
     dataset, job, sequence_id, simulate_missing = task
     record_missing(job, simulate_missing)
-    return recorded_sequence_examples(dataset, job, sequence_id)
+    return example_records(dataset, recorded_sequence_examples(dataset, job, sequence_id))
 
 
 def recorded_sequence_examples(dataset: configs.DatasetConfig, job: PushJob, sequence_id: int) -> dict[str, np.ndarray]:
