@@ -163,9 +163,12 @@ def examples_from_source(source: Sequence[Mapping[str, Any]], fields: Sequence[s
     if keys.min() < 0 or keys.max() >= count:
         raise ValueError(f"indices: expected indices in [0, {count}), got {keys.min()}..{keys.max()}")
     read = getattr(source, "__getitems__", None) or (lambda keys: [source[key] for key in keys])
-    chunks = {name: [] for name in fields}
+    examples: dict[str, np.ndarray] = {}
     for start in range(0, keys.size, _READ_CHUNK):
-        for example in read(keys[start:start + _READ_CHUNK].tolist()):
-            for name in fields:
-                chunks[name].append(example[name])
-    return {name: np.asarray(values, dtype=schema.FIELDS[name].dtype) for name, values in chunks.items()}
+        chunk = read(keys[start:start + _READ_CHUNK].tolist())
+        for name in fields:
+            values = np.asarray([example[name] for example in chunk], dtype=schema.FIELDS[name].dtype)
+            if name not in examples:  # filled chunk by chunk: the split is in memory once, not also as a list
+                examples[name] = np.empty((keys.size, *values.shape[1:]), values.dtype)
+            examples[name][start:start + len(values)] = values
+    return examples
