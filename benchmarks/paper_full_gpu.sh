@@ -10,7 +10,8 @@
 # stops at SECONDS. Models recorded in RECORDS (default results/data_efficiency_paper_full/models, the committed ones)
 # are not trained again. Writes OUT_DIR/build.log, OUT_DIR/train.log and OUT_DIR/records.tgz (the finished models'
 # records, results.json and results.md). Environment: PYTHON (default python3), DATA_DIR, WORKDIR (default under
-# /tmp); for a dry run on a CPU, SCALE (default paper_full) and ARGS (more flags of the training binary, e.g. a tiny
+# /tmp); SEEDS (default 0,1,2) and MODELS (default 6: neural and hybrid at 3 seeds; SIZE=190080 SEEDS=0 MODELS=2 is
+# part 4's pair at the full split); for a dry run on a CPU, SCALE (default paper_full) and ARGS (more flags of the training binary, e.g. a tiny
 # --criterion).
 set -uo pipefail
 out=${1:?usage: benchmarks/paper_full_gpu.sh OUT_DIR [SECONDS] [SIZE]}
@@ -38,7 +39,7 @@ tail -3 "$out/build.log"
 
 deadline=$(date -u -d "@$(( start + seconds * 3 / 4 ))" +%Y-%m-%dT%H:%M:%S)
 timeout $(( seconds - $(since) )) "$python" -m experiments.data_efficiency_full --scale="$scale" --sizes="$size" \
-  --seeds=0,1,2 --nowide --max_models=6 --models_at_once=2 --deadline="$deadline" --workdir="$work" \
+  --seeds="${SEEDS:-0,1,2}" --nowide --max_models="${MODELS:-6}" --models_at_once=2 --deadline="$deadline" --workdir="$work" \
   --data_dir="$data" ${ARGS:-} > "$out/train.log" 2>&1
 echo "training: exit $? after $(since) s"
 grep -E "read |recorded |steps/s" "$out/train.log" | grep -v "^\[" | tail -12
