@@ -10,9 +10,9 @@
 # stops at SECONDS. Models recorded in RECORDS (default results/data_efficiency_paper_full/models, the committed ones)
 # are not trained again. Writes OUT_DIR/build.log, OUT_DIR/train.log and OUT_DIR/records.tgz (the finished models'
 # records, results.json and results.md). Environment: PYTHON (default python3), DATA_DIR, WORKDIR (default under
-# /tmp); SEEDS (default 0,1,2) and MODELS (default 6: neural and hybrid at 3 seeds; SIZE=190080 SEEDS=0 MODELS=2 is
-# part 4's pair at the full split); for a dry run on a CPU, SCALE (default paper_full) and ARGS (more flags of the training binary, e.g. a tiny
-# --criterion).
+# /tmp); SEEDS (default 0,1,2) and MODELS (default 6: the next six unrecorded models of the plan, neural's and
+# hybrid's first; SIZE=190080 SEEDS=0 MODELS=2 is part 4's pair at the full split); for a dry run on a CPU, SCALE
+# (default paper_full) and ARGS (more flags of the training binary, e.g. a tiny --criterion).
 set -uo pipefail
 out=${1:?usage: benchmarks/paper_full_gpu.sh OUT_DIR [SECONDS] [SIZE]}
 seconds=${2:-480}
