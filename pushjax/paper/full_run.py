@@ -4,13 +4,13 @@ The run ``data_efficiency_full`` trains on the ``data_efficiency`` dataset at ``
 four surfaces at 20 mm/s, 190 080 training and 38 016 test examples from 528 test sequences, 64 x 64 images):
 neural, hybrid and error at every size of `SIZES`, simple and neural_dyn at `SIDE_SIZES`, seeds `SEEDS` (a different
 training subset per seed; at the full split every seed trains on the same examples, with its own initialisation and
-batch order), and `WIDE_VARIANTS` once at the paper's widths at the full split. At ``paper_full`` scale the same pushes,
-subsets and test sequences are rendered at the paper's images and every model has the paper's widths (a GPU's run). Each model trains by the convergence
-criterion of `pushjax.train.convergence` (constant rate until its validation score stops improving, within a budget
-growing with the size, then a short decay).
+batch order), and `WIDE_VARIANTS` once at the paper's widths at the full split. At ``paper_full`` scale the same
+pushes, subsets and test sequences are rendered at the paper's images and every model has the paper's widths (a GPU's
+run). Each model trains by the convergence criterion of `pushjax.train.convergence` (constant rate until its validation
+score stops improving, within a budget growing with the size, then a short decay).
 
-A unit of work is one model; `run` reads the training rows the models still to train use (`read_training_examples`:
-the whole split once a model trains on it) and trains them in order, one or a few at once (threads sharing the training split; a
+A unit of work is one model; `run` reads the training rows the models it may train use (`read_training_examples`: the
+whole split once one trains on it) and trains them in order, one or a few at once (threads sharing those rows; a
 model's record does not depend on how many). When it is trained and evaluated, its record -- the test row of ``results.json``
 (per-sequence sums included, for the bootstrap), the criterion's verdict, its steps and validation curve -- is written
 to ``<workdir>/models/<key>.json`` (a few tens of KiB), and ``results.json``, ``results.md`` and the figures are
@@ -189,8 +189,8 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Traini
     tensorboard = (None if tensorboard_dir is None else train_lib.metrics_log.TensorBoardLog(
         tensorboard_dir, [unit.key], "train", first_step=resumed))
     try:
-        trained = convergence.train_until_converged(config, train_examples.examples, model_spec, validation, criterion, log=log,
-                                                    tensorboard=tensorboard, resume_dir=resume_dir)
+        trained = convergence.train_until_converged(config, train_examples.examples, model_spec, validation, criterion,
+                                                    log=log, tensorboard=tensorboard, resume_dir=resume_dir)
     finally:
         if tensorboard is not None:
             tensorboard.close()
@@ -280,7 +280,7 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
     if todo and (max_models is None or max_models > 0):
         validation = train_lib.examples_from_source(splits["validation"], fields)
         clock = time.monotonic()
-        train_examples = read_training_examples(splits["train"], fields, todo)
+        train_examples = read_training_examples(splits["train"], fields, todo[:max_models])
         log(f"{NAME}: read {len(train_examples.rows)} of the {train_examples.split_size} training examples (the "
             f"models to train read them) in {time.monotonic() - clock:.0f} s")
         queue = _UnitQueue(todo, max_models, deadline, log)
