@@ -346,8 +346,14 @@ def keyed_examples(dataset: configs.DatasetConfig, sequence_id: int,
     examples are stored in key order.
     """
     first = sequence_id * dataset.examples_per_sequence
+    for index, example in enumerate(_unstacked(dataset, examples)):
+        yield first + index, example
+
+
+def _unstacked(dataset: configs.DatasetConfig, examples: dict[str, np.ndarray]) -> Iterator[dict[str, np.ndarray]]:
+    """The examples of a sequence's stacked examples (field -> [E, ...]), one by one."""
     for index in range(dataset.examples_per_sequence):
-        yield first + index, {name: value[index] for name, value in examples.items()}
+        yield {name: value[index] for name, value in examples.items()}
 
 
 def record_missing(job: PushJob, simulate_missing: bool) -> None:
@@ -391,8 +397,8 @@ def example_records(dataset: configs.DatasetConfig, examples: dict[str, np.ndarr
     """The stored records (`canonical_record`) of a sequence's stacked examples (field -> [E, ...]), in order: the
     same bytes in whichever process makes them."""
     features, serializer = _features_and_serializer(dataset.image_size)
-    return [canonical_record(serializer.serialize_example(features.encode_example(
-        {name: value[index] for name, value in examples.items()}))) for index in range(dataset.examples_per_sequence)]
+    return [canonical_record(serializer.serialize_example(features.encode_example(example)))
+            for example in _unstacked(dataset, examples)]
 
 
 def sequence_task(task: tuple[configs.DatasetConfig, PushJob, int, bool]) -> list[bytes]:
