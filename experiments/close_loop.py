@@ -16,6 +16,7 @@ many it found and how many it needs.
 import dataclasses
 import json
 import math
+import sys
 
 from absl import app, flags
 
@@ -61,12 +62,16 @@ def main(argv):
                             min_strength=_MIN_STRENGTH.value, effects=tuple(_EFFECTS.value),
                             fit=dataclasses.replace(FitSettings(), steps=_STEPS.value))
     try:
-        report = close_loop(_DATA_DIR.value, _WORKDIR.value, settings, seed=_SEED.value).report.as_dict()
+        result = close_loop(_DATA_DIR.value, _WORKDIR.value, settings, seed=_SEED.value)
     except ValueError as error:
         message = str(error)
         if message.startswith("data_dir"):
             message = "--" + message
         raise app.UsageError(message) from None
+    report = result.report.as_dict()
+    if not all(round_.converged for round_ in result.details.rounds):
+        print(f"warning: the fits had not converged at --steps={_STEPS.value}: selection stopped early "
+              f"(report.md, \"Forward selection\"); rerun with more --steps", file=sys.stderr)
     summary = {key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "noise_floor", "explained",
                                             "fallback", "remaining")}
     print(json.dumps(summary, indent=2))

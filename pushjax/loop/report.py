@@ -252,6 +252,7 @@ class LoopDetails:
                         "mechanism": [{**dataclasses.asdict(check), "p_value": check.p_value,
                                        "variable": check.variable, "knob": check.is_knob(self.alpha)}
                                       for check in r.mechanism],
+                        "incumbent_change": r.incumbent_change, "converged": r.converged,
                         "accepted": r.accepted, "indistinguishable": r.indistinguishable} for r in self.rounds],
             "fallback_select": {"gain": self.fallback_gain, "p_value": self.fallback_p_value,
                                 "beyond_noise": self.fallback_beyond_noise},
@@ -497,6 +498,12 @@ def markdown(result: LoopResult) -> str:
         lines.append(f"{k}. {'added' if round_.accepted else 'stop; largest gain'} `{best}`: gain "
                      f"{round_.gains[index]:+.3f}, p = {round_.p_values[index]:.2g} (Holm level "
                      f"{round_.levels[index]:.2g}); candidates beyond noise: {', '.join(passed) or 'none'}")
+        if k > 1:
+            lines.append(f"   - the current model fitted as far as the candidates (the gains' reference): selection "
+                         f"score {-100 * round_.incumbent_change:+.2f} %"
+                         + ("" if round_.converged else
+                            f", more than {100 * select_lib.CONVERGENCE_TOLERANCE:g} %: **its fits had not converged**, "
+                            "so nothing is added (rerun with more `--steps`)"))
         for check in round_.mechanism:
             if check.p_value is None:
                 verdict = "not testable here (one group, or too few sequences per group)"

@@ -21,6 +21,13 @@ subsumes ``friction_ratio`` and ``pressure_gradient``, replaces them) and tests 
   weight: ``Effect.per_object``) are compared across surfaces and velocities only.
 
 Among the candidates that pass, the one with the largest gain is added; selection stops when none passes.
+
+From the second round on, a candidate's fit starts from the current model's and runs ``warm_steps`` further, so the
+current model is fitted as far in the same call (its continuation) and every gain is measured against that: an added
+effect must not win by the extra steps alone. The continuation is also the fits' convergence check: where it lowers
+the current model's selection score by more than :data:`CONVERGENCE_TOLERANCE`, the fits had not converged, and the
+round adds nothing (selection stops; raise the fit steps) — an effect that takes up an under-fitted one's misfit is
+a knob, not a discovery (BENCHMARKS.md, "Does the loop's fit converge?").
 The other candidates that passed the first two tests and whose gain the added one does not beat beyond noise (the
 same sign-flip test on the per-sequence difference, at ``alpha``) are its indistinguishable rivals: the data cannot
 tell the added effect from them (a table-fixed friction field and a moved centre of mass from one start pose), and
@@ -42,6 +49,11 @@ from pushjax.physics.effects import EFFECT_NAMES, EFFECTS
 
 MIN_GAIN = 0.05
 """Default share of the current model's selection error above the noise floor that an added effect must remove."""
+CONVERGENCE_TOLERANCE = 0.01
+"""Largest share of the current model's selection score that fitting it ``warm_steps`` further may remove for its
+fits to count as converged (fixed before it was measured on the loop's data sets). At the default 300 steps the exact
+limit surface's fit loss on a centre-loaded pressure is within 0.2 % of its converged value, at 150 steps 10 % above it
+(BENCHMARKS.md)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -146,6 +158,11 @@ class Round:
       floor: the gain (points of the combined score) an addition had to exceed: ``min_gain`` times the current
         error above the noise floor.
       mechanism: the mechanism checks made in this round, in the order of the candidates' gains.
+      incumbent_change: the share of the current model's selection score that fitting it ``warm_steps`` further
+        removed (its continuation, which the gains are measured against; 0 in the first round, whose current model,
+        the plain one, has nothing to fit).
+      converged: whether ``incumbent_change`` is at most :data:`CONVERGENCE_TOLERANCE`; a round whose fits have not
+        converged adds nothing.
       accepted: the effect added in this round, or None (selection stops).
       indistinguishable: {effect: one-sided p-value that the accepted effect's gain exceeds its gain} of the other
         candidates beyond noise and above the floor, with a smaller gain, that the accepted one does not beat at
@@ -160,6 +177,8 @@ class Round:
     beyond_noise: list[bool]
     floor: float
     mechanism: list[MechanismCheck]
+    incumbent_change: float
+    converged: bool
     accepted: str | None
     indistinguishable: dict[str, float]
 
@@ -189,6 +208,11 @@ class Selection:
         """The final model's effects in the order they were selected (one replaced by a later one left out)."""
         accepted = [round_.accepted for round_ in self.rounds if round_.accepted is not None]
         return [name for name in accepted if name in self.final.effects]
+
+    @property
+    def converged(self) -> bool:
+        """Whether every round's fits passed the convergence check (see :data:`CONVERGENCE_TOLERANCE`)."""
+        return all(round_.converged for round_ in self.rounds)
 
     @property
     def alternatives(self) -> dict[str, dict[str, float]]:
@@ -256,14 +280,20 @@ def select_effects(
     single_params = [{c.effects[0]: c.fits[k].params[c.effects[0]] for c in singles} for k in range(len(folds.fit))]
 
     current, candidates, additions, rounds = baseline, singles, list(effects), []
+    continued = None
     while candidates:
+        incumbent_change = 0.0
+        if continued is not None:
+            incumbent_change = (current.score - continued.score) / max(current.score, np.finfo(float).tiny)
+            current = continued
+        converged = incumbent_change <= CONVERGENCE_TOLERANCE
         per_sequence = metrics.sequence_gains(current.errors, [c.errors for c in candidates])
         points = per_sequence.sum(axis=1)
         gains = [float(g) for g in points / current.score]
         p_values = metrics.sign_flip_pvalues(per_sequence, seed=seed)
         beyond_noise, levels = metrics.holm(p_values, alpha)
         required = min_gain * max(current.score - floor.score, 0.0)
-        passing = np.flatnonzero(beyond_noise & (points > required))
+        passing = np.flatnonzero(beyond_noise & (points > required) & converged)
         best, checks = None, []
         for index in passing[np.argsort(-points[passing], kind="stable")]:
             checks.append(check_mechanism(split.pool, candidates[index].effects, additions[index], settings,
@@ -274,6 +304,7 @@ def select_effects(
         rounds.append(Round(candidates=candidates, additions=additions, gains=gains,
                             p_values=[float(p) for p in p_values], levels=[float(level) for level in levels],
                             beyond_noise=[bool(b) for b in beyond_noise], floor=float(required), mechanism=checks,
+                            incumbent_change=float(incumbent_change), converged=bool(converged),
                             accepted=additions[best] if best is not None else None,
                             indistinguishable=_rivals(per_sequence, points, passing, best, additions, alpha, seed)))
         if best is None:
@@ -282,14 +313,15 @@ def select_effects(
         sets, additions = _next_sets(current.effects, effects)
         if not sets:
             break
-        report(f"fitting {current.effects} plus one of {len(sets)} effects")
-        per_fold = [fit_lib.fit_effects(sets, fit, settings,
+        report(f"fitting {current.effects} plus one of {len(sets)} effects, and {current.effects} further")
+        per_fold = [fit_lib.fit_effects(sets + [current.effects], fit, settings,
                                         initial=[{**{name: current.fits[k].params[name] for name in effects_set
                                                      if name in current.effects},
                                                   name: single_params[k][name]}
-                                                 for effects_set, name in zip(sets, additions)])
+                                                 for effects_set, name in zip(sets, additions)]
+                                        + [current.fits[k].params])
                     for k, fit in enumerate(folds.fit)]
-        candidates = folds.evaluate(sets, per_fold)
+        *candidates, continued = folds.evaluate(sets + [current.effects], per_fold)
     model = None
     if current.effects:
         report(f"refitting {current.effects} on every pool sequence")

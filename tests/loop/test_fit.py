@@ -58,6 +58,8 @@ def test_forward_selection_adds_both_effects_and_stops(synthetic):
     shift = next(effect for effect in selection.selected if effect != "friction_ratio")
     assert shift in CENTRE_SHIFTS
     assert selection.rounds[-1].accepted is None and len(selection.rounds) == 3
+    assert selection.converged and all(abs(r.incumbent_change) <= select.CONVERGENCE_TOLERANCE
+                                       for r in selection.rounds)
     assert selection.ranking[0].effects[0] in TRUE
     assert selection.final.score < 0.5 * selection.baseline.score
     # The reported model is refitted on the pool (fit and select sequences, never the test split's) and recovers
@@ -65,6 +67,19 @@ def test_forward_selection_adds_both_effects_and_stops(synthetic):
     assert set(selection.model.effects) == set(selection.selected)
     np.testing.assert_allclose(selection.model.params[shift]["offset"], TRUE["cof_offset"]["offset"], atol=5e-4)
     assert not set(split.pool.sequence) & set(split.test.sequence)
+
+
+def test_fits_stopped_far_from_their_optimum_add_nothing(synthetic):
+    # Ten Adam steps leave the first effect's fit far from its optimum: fitting it further (as far as the second
+    # round's candidates) moves its selection score by more than the tolerance, so the round refuses instead of
+    # crediting the second effect with the first one's unfinished fit.
+    split = splits.split(synthetic, len(EFFECT_NAMES), seed=1)
+    selection = select.select_effects(split, settings=fit.FitSettings(steps=10, warm_steps=10))
+    first, second = selection.rounds[:2]
+    assert first.converged and first.accepted is not None
+    assert second.incumbent_change > select.CONVERGENCE_TOLERANCE and not second.converged
+    assert second.accepted is None and len(selection.rounds) == 2 and not selection.converged
+    assert selection.selected == [first.accepted]
 
 
 def test_error_correction_learns_what_the_model_misses(synthetic):
