@@ -252,7 +252,8 @@ class LoopDetails:
                         "mechanism": [{**dataclasses.asdict(check), "p_value": check.p_value,
                                        "variable": check.variable, "knob": check.is_knob(self.alpha)}
                                       for check in r.mechanism],
-                        "incumbent_change": r.incumbent_change, "converged": r.converged,
+                        "incumbent_change": r.incumbent_change, "continuations": r.continuations,
+                        "converged": r.converged,
                         "accepted": r.accepted, "indistinguishable": r.indistinguishable} for r in self.rounds],
             "fallback_select": {"gain": self.fallback_gain, "p_value": self.fallback_p_value,
                                 "beyond_noise": self.fallback_beyond_noise},
@@ -501,6 +502,8 @@ def markdown(result: LoopResult) -> str:
         if k > 1:
             lines.append(f"   - the current model fitted as far as the candidates (the gains' reference): selection "
                          f"score {-100 * round_.incumbent_change:+.2f} %"
+                         + (f" in the last of {round_.continuations + 1} continuations of every fit"
+                            if round_.continuations else "")
                          + ("" if round_.converged else
                             f", more than {100 * select_lib.CONVERGENCE_TOLERANCE:g} %: **its fits had not converged**, "
                             "so nothing is added (rerun with more `--steps`)"))

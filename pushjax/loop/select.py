@@ -25,9 +25,10 @@ Among the candidates that pass, the one with the largest gain is added; selectio
 From the second round on, a candidate's fit starts from the current model's and runs ``warm_steps`` further, so the
 current model is fitted as far in the same call (its continuation) and every gain is measured against that: an added
 effect must not win by the extra steps alone. The continuation is also the fits' convergence check: where it lowers
-the current model's selection score by more than :data:`CONVERGENCE_TOLERANCE`, the fits had not converged, and the
-round adds nothing (selection stops; raise the fit steps) — an effect that takes up an under-fitted one's misfit is
-a knob, not a discovery (BENCHMARKS.md, "Does the loop's fit converge?").
+the current model's selection score by more than :data:`CONVERGENCE_TOLERANCE`, every fit of the round is continued
+by ``warm_steps`` again, up to :data:`MAX_CONTINUATIONS` times; a round whose fits still have not converged adds
+nothing (selection stops; raise the fit steps) — an effect that takes up an under-fitted one's misfit is a knob, not a
+discovery (BENCHMARKS.md, "Does the loop's fit converge?").
 The other candidates that passed the first two tests and whose gain the added one does not beat beyond noise (the
 same sign-flip test on the per-sequence difference, at ``alpha``) are its indistinguishable rivals: the data cannot
 tell the added effect from them (a table-fixed friction field and a moved centre of mass from one start pose), and
@@ -54,6 +55,8 @@ CONVERGENCE_TOLERANCE = 0.01
 fits to count as converged (fixed before it was measured on the loop's data sets). At the default 300 steps the exact
 limit surface's fit loss on a centre-loaded pressure is within 0.2 % of its converged value, at 150 steps 10 % above it
 (BENCHMARKS.md)."""
+MAX_CONTINUATIONS = 3
+"""How many times a round's fits are continued by ``warm_steps`` more where the current model's has not converged."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -158,9 +161,11 @@ class Round:
       floor: the gain (points of the combined score) an addition had to exceed: ``min_gain`` times the current
         error above the noise floor.
       mechanism: the mechanism checks made in this round, in the order of the candidates' gains.
-      incumbent_change: the share of the current model's selection score that fitting it ``warm_steps`` further
-        removed (its continuation, which the gains are measured against; 0 in the first round, whose current model,
-        the plain one, has nothing to fit).
+      incumbent_change: the share of the current model's selection score that its last continuation by
+        ``warm_steps`` removed (the continued model is what the gains are measured against; 0 in the first round, whose
+        current model, the plain one, has nothing to fit).
+      continuations: how many times the round's fits were continued beyond the first ``warm_steps`` because the
+        current model's had not converged (at most :data:`MAX_CONTINUATIONS`).
       converged: whether ``incumbent_change`` is at most :data:`CONVERGENCE_TOLERANCE`; a round whose fits have not
         converged adds nothing.
       accepted: the effect added in this round, or None (selection stops).
@@ -178,6 +183,7 @@ class Round:
     floor: float
     mechanism: list[MechanismCheck]
     incumbent_change: float
+    continuations: int
     converged: bool
     accepted: str | None
     indistinguishable: dict[str, float]
@@ -280,12 +286,8 @@ def select_effects(
     single_params = [{c.effects[0]: c.fits[k].params[c.effects[0]] for c in singles} for k in range(len(folds.fit))]
 
     current, candidates, additions, rounds = baseline, singles, list(effects), []
-    continued = None
+    incumbent_change, continuations = 0.0, 0
     while candidates:
-        incumbent_change = 0.0
-        if continued is not None:
-            incumbent_change = (current.score - continued.score) / max(current.score, np.finfo(float).tiny)
-            current = continued
         converged = incumbent_change <= CONVERGENCE_TOLERANCE
         per_sequence = metrics.sequence_gains(current.errors, [c.errors for c in candidates])
         points = per_sequence.sum(axis=1)
@@ -304,7 +306,8 @@ def select_effects(
         rounds.append(Round(candidates=candidates, additions=additions, gains=gains,
                             p_values=[float(p) for p in p_values], levels=[float(level) for level in levels],
                             beyond_noise=[bool(b) for b in beyond_noise], floor=float(required), mechanism=checks,
-                            incumbent_change=float(incumbent_change), converged=bool(converged),
+                            incumbent_change=float(incumbent_change), continuations=continuations,
+                            converged=bool(converged),
                             accepted=additions[best] if best is not None else None,
                             indistinguishable=_rivals(per_sequence, points, passing, best, additions, alpha, seed)))
         if best is None:
@@ -314,14 +317,20 @@ def select_effects(
         if not sets:
             break
         report(f"fitting {current.effects} plus one of {len(sets)} effects, and {current.effects} further")
-        per_fold = [fit_lib.fit_effects(sets + [current.effects], fit, settings,
-                                        initial=[{**{name: current.fits[k].params[name] for name in effects_set
-                                                     if name in current.effects},
-                                                  name: single_params[k][name]}
-                                                 for effects_set, name in zip(sets, additions)]
-                                        + [current.fits[k].params])
-                    for k, fit in enumerate(folds.fit)]
-        *candidates, continued = folds.evaluate(sets + [current.effects], per_fold)
+        starts = [[{**{name: current.fits[k].params[name] for name in effects_set if name in current.effects},
+                    name: single_params[k][name]} for effects_set, name in zip(sets, additions)]
+                  for k in range(len(folds.fit))]
+        for continuations in range(MAX_CONTINUATIONS + 1):
+            per_fold = [fit_lib.fit_effects(sets + [current.effects], fit, settings,
+                                            initial=starts[k] + [current.fits[k].params])
+                        for k, fit in enumerate(folds.fit)]
+            *candidates, continued = folds.evaluate(sets + [current.effects], per_fold)
+            incumbent_change = (current.score - continued.score) / max(current.score, np.finfo(float).tiny)
+            current = continued
+            if incumbent_change <= CONVERGENCE_TOLERANCE or continuations == MAX_CONTINUATIONS:
+                break
+            report(f"continuing the fits of {current.effects} and its candidates (not converged)")
+            starts = [[candidate.fits[k].params for candidate in candidates] for k in range(len(folds.fit))]
     model = None
     if current.effects:
         report(f"refitting {current.effects} on every pool sequence")

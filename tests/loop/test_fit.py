@@ -59,7 +59,7 @@ def test_forward_selection_adds_both_effects_and_stops(synthetic):
     assert shift in CENTRE_SHIFTS
     assert selection.rounds[-1].accepted is None and len(selection.rounds) == 3
     assert selection.converged and all(abs(r.incumbent_change) <= select.CONVERGENCE_TOLERANCE
-                                       for r in selection.rounds)
+                                       and r.continuations == 0 for r in selection.rounds)
     assert selection.ranking[0].effects[0] in TRUE
     assert selection.final.score < 0.5 * selection.baseline.score
     # The reported model is refitted on the pool (fit and select sequences, never the test split's) and recovers
@@ -70,13 +70,14 @@ def test_forward_selection_adds_both_effects_and_stops(synthetic):
 
 
 def test_fits_stopped_far_from_their_optimum_add_nothing(synthetic):
-    # Ten Adam steps leave the first effect's fit far from its optimum: fitting it further (as far as the second
-    # round's candidates) moves its selection score by more than the tolerance, so the round refuses instead of
+    # Ten Adam steps leave the first effect's fit far from its optimum, and each continuation by ten more moves its
+    # selection score by more than the tolerance, so after the last continuation the round refuses instead of
     # crediting the second effect with the first one's unfinished fit.
     split = splits.split(synthetic, len(EFFECT_NAMES), seed=1)
     selection = select.select_effects(split, settings=fit.FitSettings(steps=10, warm_steps=10))
     first, second = selection.rounds[:2]
     assert first.converged and first.accepted is not None
+    assert second.continuations == select.MAX_CONTINUATIONS
     assert second.incumbent_change > select.CONVERGENCE_TOLERANCE and not second.converged
     assert second.accepted is None and len(selection.rounds) == 2 and not selection.converged
     assert selection.selected == [first.accepted]

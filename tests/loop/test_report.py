@@ -57,9 +57,11 @@ def small_result(measured_friction: bool) -> report_lib.LoopResult:
                          MechanismCheck("cof_offset", [Heterogeneity("object", "offset_y_mm", 0.01, 0.625),
                                                        Heterogeneity("surface", "offset_x_mm", 0.5, 0.25)], {}),
                          MechanismCheck("cof_offset", [], {})],
-              incumbent_change=0.0, converged=True, accepted="cof_offset", indistinguishable={"friction_field": 0.125}),
+              incumbent_change=0.0, continuations=0, converged=True, accepted="cof_offset",
+              indistinguishable={"friction_field": 0.125}),
         Round(candidates=[], additions=["table_tilt"], gains=[-0.125], p_values=[0.75], levels=[0.05],
-              beyond_noise=[False], floor=0.75, mechanism=[], incumbent_change=0.015625, converged=False,
+              beyond_noise=[False], floor=0.75, mechanism=[], incumbent_change=0.015625, continuations=3,
+              converged=False,
               accepted=None, indistinguishable={}),
     ]
     report = report_lib.LoopReport(
