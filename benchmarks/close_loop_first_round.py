@@ -15,6 +15,7 @@ PUSHES: e.g. ``tests/loop``'s case ``pressure``, recorded as in benchmarks/close
 """
 
 import dataclasses
+from pathlib import Path
 
 from absl import app, flags
 
@@ -36,6 +37,8 @@ _SEED = flags.DEFINE_integer("seed", 0, "Seed of the split (as experiments.close
 
 def main(argv):
     del argv
+    if not Path(_DATA_DIR.value).is_dir():
+        raise app.UsageError(f"--data_dir={_DATA_DIR.value}: not a directory")
     pushes = iter_pushes(_DATA_DIR.value)
     if not pushes.paths:
         raise app.UsageError(f"--data_dir={_DATA_DIR.value}: no push files (motion_surface=...h5) below it")
