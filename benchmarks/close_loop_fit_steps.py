@@ -3,12 +3,12 @@
 Fits each candidate (`pushjax.loop.fit.fit_effects`, the loop's optimiser) on the windows of the first ``--pushes``
 push files under ``--data_dir`` (MIT layout; windows as `experiments.close_loop` cuts them by default, overlapping by
 half, or ``--stride`` apart) at every step count of ``--steps``, and prints each fit's loss and, for the candidates with more than one
-effect, the fitted parameters of ``--show``. A loss still falling between the default (300) and more steps means the
+effect (and alone too with ``--show_alone``), the fitted parameters of ``--show``. A loss still falling between the default (300) and more steps means the
 selection compares fits that have not converged; an effect whose parameters move towards zero as the others converge
 is absorbing their misfit.
 
     python benchmarks/close_loop_fit_steps.py --data_dir=PUSHES [--pushes=40] [--steps=150,300,600,1200] \
-        [--candidates=limit_surface;limit_surface,table_tilt;table_tilt] [--show=table_tilt] [--stride=0.5]
+        [--candidates=limit_surface;limit_surface,table_tilt;table_tilt] [--show=table_tilt] [--show_alone] [--stride=0.5]
 
 PUSHES: e.g. a centre-loaded pressure like ``tests/loop``'s case ``pressure`` (rect1 on polyurethane, ideal testbed),
 recorded with ``python -m experiments.record_pushes --out_dir=PUSHES --objects=rect1 --surfaces=pu --pushes=120 --seed=1 --effects=pressure_rim=-4.0 --declare_effects=false --testbed=ideal``.
@@ -29,6 +29,7 @@ _STEPS = flags.DEFINE_list("steps", ["150", "300", "600", "1200"], "Adam step co
 _CANDIDATES = flags.DEFINE_string("candidates", "limit_surface;limit_surface,table_tilt;table_tilt",
                                   "Candidate effect sets, ';' between sets, ',' between effects.")
 _SHOW = flags.DEFINE_string("show", "table_tilt", "Effect whose fitted parameters are printed.")
+_SHOW_ALONE = flags.DEFINE_bool("show_alone", False, "Also print --show's parameters where it is fitted alone.")
 _STRIDE = flags.DEFINE_float("stride", None, "Seconds between window starts (default: half the 0.5 s horizon, as "
                              "experiments.close_loop; tests/loop's STRIDE is 0.5).", lower_bound=0.0)
 
@@ -51,7 +52,7 @@ def main(argv):
     for steps in map(int, _STEPS.value):
         results = fit_effects(candidates, examples, FitSettings(steps=steps))
         shown = "; ".join(f"{name} {', '.join(f'{x:.4f}' for x in value.ravel())}" for result in results
-                          if _SHOW.value in result.effects and len(result.effects) > 1
+                          if _SHOW.value in result.effects and (len(result.effects) > 1 or _SHOW_ALONE.value)
                           for name, value in result.params[_SHOW.value].items())
         print(f"| {steps} | " + " | ".join(f"{result.loss:.5f}" for result in results) + f" | {shown} |")
 
