@@ -22,17 +22,19 @@ subsumes ``friction_ratio`` and ``pressure_gradient``, replaces them) and tests 
 
 Among the candidates that pass, the one with the largest gain is added; selection stops when none passes.
 
+The other candidates that passed the first two tests and whose gain the added one does not beat beyond noise (the
+same sign-flip test on the per-sequence difference, at ``alpha``) are its indistinguishable rivals: the data cannot
+tell the added effect from them (a table-fixed friction field and a moved centre of mass from one start pose), and
+the report names them. The selected set is then refitted on the whole pool; the test split is never used here.
+
 From the second round on, a candidate's fit starts from the current model's and runs ``warm_steps`` further, so the
 current model is fitted as far in the same call (its continuation) and every gain is measured against that: an added
 effect must not win by the extra steps alone. The continuation is also the fits' convergence check: where it lowers
 the current model's selection score by more than :data:`CONVERGENCE_TOLERANCE`, every fit of the round is continued
 by ``warm_steps`` again, up to :data:`MAX_CONTINUATIONS` times; a round whose fits still have not converged adds
 nothing (selection stops; raise the fit steps) — an effect that takes up an under-fitted one's misfit is a knob, not a
-discovery (BENCHMARKS.md, "Does the loop's fit converge?").
-The other candidates that passed the first two tests and whose gain the added one does not beat beyond noise (the
-same sign-flip test on the per-sequence difference, at ``alpha``) are its indistinguishable rivals: the data cannot
-tell the added effect from them (a table-fixed friction field and a moved centre of mass from one start pose), and
-the report names them. The selected set is then refitted on the whole pool; the test split is never used here.
+discovery (BENCHMARKS.md, "Does the loop's fit converge?"). The first round's single fits are not checked
+(their current model, the plain one, has nothing to fit).
 """
 
 from __future__ import annotations
