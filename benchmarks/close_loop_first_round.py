@@ -14,17 +14,15 @@ continuation, the first round picked by the number of steps.
 PUSHES: e.g. ``tests/loop``'s case ``pressure``, recorded as in benchmarks/close_loop_fit_steps.py's docstring.
 """
 
-import dataclasses
 from pathlib import Path
 
 from absl import app, flags
 
-from pushjax.loop import LoopSettings, force, select, splits
+from pushjax.loop import LoopSettings, select
 from pushjax.loop.fit import FitSettings, fit_effects
-from pushjax.loop.pipeline import with_pusher_friction
+from pushjax.loop.pipeline import measured_split
 from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes
-from pushjax.physics.effects import EFFECT_NAMES
 
 _DATA_DIR = flags.DEFINE_string("data_dir", None, "Root of the push files (MIT layout).", required=True)
 _STEPS = flags.DEFINE_integer("steps", FitSettings.steps, "Adam steps of the first fit.", lower_bound=1)
@@ -43,14 +41,7 @@ def main(argv):
     if not pushes.paths:
         raise app.UsageError(f"--data_dir={_DATA_DIR.value}: no push files (motion_surface=...h5) below it")
     examples, _ = build_examples(pushes, stride=_STRIDE.value)
-    loop = LoopSettings()
-    split = splits.split(examples, len(loop.effects), loop.alpha, loop.test_fraction, loop.select_fraction, _SEED.value)
-    friction = force.estimate(split.pool.push_friction, split.pool.push, split.pool.sequence)
-    effects = list(EFFECT_NAMES)
-    if friction.measured:  # as pushjax.loop.pipeline.decide: the measured coefficient, no pusher_friction candidate
-        split = dataclasses.replace(split, pool=with_pusher_friction(split.pool, friction.value),
-                                    test=with_pusher_friction(split.test, friction.value))
-        effects.remove("pusher_friction")
+    split, _, effects = measured_split(examples, LoopSettings(), _SEED.value)
     folds = select._Folds(split)
     settings = FitSettings(steps=_STEPS.value, warm_steps=_WARM_STEPS.value)
     sets = [(name,) for name in effects]

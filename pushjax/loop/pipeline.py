@@ -128,14 +128,7 @@ def decide(examples: Examples, settings: LoopSettings = LoopSettings(), seed: in
       ValueError: too few push sequences (see :func:`pushjax.loop.splits.split`).
     """
     report = progress or (lambda message: None)
-    split = splits_lib.split(examples, len(settings.effects), settings.alpha, settings.test_fraction,
-                             settings.select_fraction, seed)
-    force = force_lib.estimate(split.pool.push_friction, split.pool.push, split.pool.sequence)
-    effects = settings.effects
-    if settings.measure_pusher_friction and force.measured:
-        split = dataclasses.replace(split, pool=with_pusher_friction(split.pool, force.value),
-                                    test=with_pusher_friction(split.test, force.value))
-        effects = tuple(name for name in effects if name != "pusher_friction")
+    split, force, effects = measured_split(examples, settings, seed)
     diagnose = dict(min_strength=settings.min_strength, n_bootstrap=settings.n_bootstrap, alpha=settings.alpha,
                     seed=seed)
     variables = [name for name, values in split.pool.variables.items() if len(np.unique(values)) > 1]
@@ -170,6 +163,22 @@ def decide(examples: Examples, settings: LoopSettings = LoopSettings(), seed: in
                     selected_multipliers=metrics.interval_multipliers(local / noise),
                     fallback_multipliers=metrics.interval_multipliers(fallback_z),
                     alpha=settings.alpha)
+
+
+def measured_split(examples: Examples, settings: LoopSettings = LoopSettings(), seed: int = 0
+                   ) -> tuple[splits_lib.Split, force_lib.ForceFriction, tuple[str, ...]]:
+    """The fit/select/test roles of the windows, the pusher friction the force sensor reads on the pool and the
+    candidate effects: where the sensor measured it, every window carries the measured coefficient and
+    ``pusher_friction`` is no candidate."""
+    split = splits_lib.split(examples, len(settings.effects), settings.alpha, settings.test_fraction,
+                             settings.select_fraction, seed)
+    force = force_lib.estimate(split.pool.push_friction, split.pool.push, split.pool.sequence)
+    effects = settings.effects
+    if settings.measure_pusher_friction and force.measured:
+        split = dataclasses.replace(split, pool=with_pusher_friction(split.pool, force.value),
+                                    test=with_pusher_friction(split.test, force.value))
+        effects = tuple(name for name in effects if name != "pusher_friction")
+    return split, force, effects
 
 
 def with_pusher_friction(examples: Examples, mu: float) -> Examples:
