@@ -1,14 +1,14 @@
 r"""Build a push dataset (TFDS, array_record) for one experiment of the paper at one scale.
 
   python -m experiments.build_dataset --experiment=data_efficiency --scale=smoke --data_dir=DIR \
-      [--testbed=realistic|ideal] [--seed=0] [--workers=N] [--raw_dir=DIR]
+      [--testbed=realistic|ideal] [--seed=0] [--workers=N] [--raw_dir=DIR] [--min_test_sequences=N]
   python -m experiments.build_dataset ... --beam_runner=DirectRunner [--beam_options="--direct_num_workers=2"]
 
 Experiments: data_efficiency, new_pushes, velocities, objects, viewpoint, repeated (``all`` builds each);
 scales: smoke, cpu (default), paper; see ``pushjax.data.configs``. The push sequences are simulated with the
 ``--testbed`` profile (``pushjax.sim.testbed``: ``realistic`` by default, ``ideal`` the clean reference) into a raw
 MIT-layout cache (``<data_dir>/push_effects_raw/<testbed>/seed<seed>``), examples are made on all cores and written
-to ``<data_dir>/push_effects/<experiment>_<scale>[_ideal][_seed<seed>]/3.0.0``. ``--raw_dir`` reads the sequences
+to ``<data_dir>/push_effects/<experiment>_<scale>[_ideal][_test<N>][_seed<seed>]/3.0.0``. ``--raw_dir`` reads the sequences
 from a folder of your own instead (e.g. real MIT files), read-only: it must hold every planned file, else the build
 stops, counting the missing files and naming the first; nothing is ever written into it. ``--beam_runner``
 simulates, renders and writes with Apache Beam on that runner instead (``pip install 'pushjax[beam]'``), passing it
@@ -37,6 +37,9 @@ _SCALE = flags.DEFINE_enum("scale", configs.DEFAULT_SCALE, list(configs.SCALES),
 _DATA_DIR = flags.DEFINE_string("data_dir", None, "TFDS data directory.", required=True)
 _SEED = flags.DEFINE_integer("seed", 0, "Dataset seed.", lower_bound=0)
 _TESTBED = experiments.define_testbed_flag()
+_MIN_TEST_SEQUENCES = flags.DEFINE_integer(
+    "min_test_sequences", 0, "Build the experiment's test splits grown to at least this many push sequences, a "
+    "test-only dataset <experiment>_<scale>_test<N> (0: the experiment's dataset).", lower_bound=0)
 _WORKERS = flags.DEFINE_integer("workers", None, "Worker processes (default: all cores).", lower_bound=1)
 _RAW_DIR = flags.DEFINE_string(
     "raw_dir", None, "Read-only MIT-layout folder holding every planned sequence file (e.g. real MIT files); "
@@ -116,13 +119,16 @@ def main(argv):
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
     names = configs.EXPERIMENTS if _EXPERIMENT.value == "all" else (_EXPERIMENT.value,)
+    if _EXPERIMENT.value == "all" and _MIN_TEST_SEQUENCES.value:
+        names = tuple(name for name in names if name != "repeated")  # one push, nothing to grow
     beam_options = None if _BEAM_OPTIONS.value is None else _pipeline_options(_BEAM_OPTIONS.value)
     for experiment in names:
         try:
             builder = build(experiment, _SCALE.value, data_dir=_DATA_DIR.value, seed=_SEED.value,
                             testbed=_TESTBED.value, workers=_WORKERS.value, raw_dir=_RAW_DIR.value,
-                            beam_runner=_BEAM_RUNNER.value, beam_options=beam_options)
-        except IncompleteRawDirError as error:
+                            beam_runner=_BEAM_RUNNER.value, beam_options=beam_options,
+                            min_test_sequences=_MIN_TEST_SEQUENCES.value)
+        except (IncompleteRawDirError, ValueError) as error:
             raise app.UsageError(f"--{error}") from None
         sizes = ", ".join(f"{name} {split.num_examples}" for name, split in builder.info.splits.items())
         print(f"{builder.builder_config.name}: {sizes} examples in {os.fspath(builder.data_dir)}")

@@ -3,6 +3,10 @@
 #
 #   bash scripts/results.sh [RUNS_DIR]      (default: work/results; SEEDS=0,1,2 and SCALE=cpu by default)
 #
+# MIN_TEST_SEQUENCES=150 evaluates every experiment on its test splits grown to at least 150 push sequences
+# (`--min_test_sequences`; the same training and validation data, so the same models as without it); give it its
+# own RUNS_DIR and PUBLISHED_DIR (e.g. results/test150).
+#
 # Resumable: stop it at any time and run it again. Training resumes from each sweep's last checkpoint, and an
 # experiment this script finished is not run again. A finished experiment's tables, curves and figures (results.json,
 # results.md, curves.csv, *.png: small files, no checkpoints) are published to `results/<name>/` in the repository,
@@ -19,6 +23,7 @@ cd "$(dirname "$0")/.."
 runs=${1:-work/results}
 seeds=${SEEDS:-0,1,2}
 scale=${SCALE:-cpu}
+min_test=${MIN_TEST_SEQUENCES:-0}
 export MUJOCO_GL=${MUJOCO_GL:-egl}
 python=${PYTHON:-.venv/bin/python}
 published=${PUBLISHED_DIR:-results}
@@ -28,7 +33,8 @@ run() {
   if [[ -f "$published/$name/results.json" ]]; then echo "$name: done ($published/$name/results.json)"; return; fi
   echo "$name: running (log $runs/$name.log)"
   mkdir -p "$runs/$name"
-  "$python" -m experiments."$name" --workdir="$runs/$name" --scale="$scale" --seeds="$seeds" "$@" \
+  "$python" -m experiments."$name" --workdir="$runs/$name" --scale="$scale" --seeds="$seeds" \
+    --min_test_sequences="$min_test" "$@" \
     >> "$runs/$name.log" 2>&1
   mkdir -p "$published/$name.partial"
   find "$runs/$name" -maxdepth 1 -type f \( -name 'results.json' -o -name 'results.md' -o -name 'curves.csv' \
@@ -48,7 +54,7 @@ share() {  # share FROM TO SWEEP...: copy finished sweeps of experiment FROM int
 run data_efficiency
 # visualize only evaluates data_efficiency's sweeps: run it while they are still in RUNS_DIR.
 share data_efficiency visualize train/l1/neural train/l1/hybrid train/l1/simple train/l1/error
-run visualize --sizes=2500,190000
+run visualize --sizes=2500,190000 --min_test_sequences=0  # its test split is one repeated push
 share data_efficiency error_variants train/l1/hybrid train/l1/error_error_grad_error_norm
 run viewpoint
 run error_variants

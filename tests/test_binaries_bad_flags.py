@@ -98,6 +98,8 @@ CASES = [
     ("data_efficiency", [*RUN, "--workdir="], "--workdir"),
     ("data_efficiency", [*RUN, "--workdir={file}/work"], "--workdir"),
     ("data_efficiency", [*RUN, "--workdir={read_only}/work"], "--workdir"),
+    ("data_efficiency", [*RUN, "--min_test_sequences=-3"], "--min_test_sequences"),
+    ("visualize", [*RUN, "--min_test_sequences=150"], "--min_test_sequences"),
     ("data_efficiency", [*RUN, "--sizes=ten"], "--sizes"),
     ("data_efficiency", [*RUN, "--sizes=0"], "--sizes"),
     ("data_efficiency", [*RUN, "--sizes=-5"], "--sizes"),
@@ -160,6 +162,8 @@ CASES = [
     ("build_dataset", ["--data_dir={tmp}/data", "--workers=0"], "--workers"),
     ("build_dataset", ["--data_dir={tmp}/data", "--raw_dir={tmp}/missing"], "--raw_dir"),
     ("build_dataset", ["--data_dir={tmp}/data", "--testbed=perfect"], "--testbed"),
+    ("build_dataset", ["--data_dir={tmp}/data", "--experiment=repeated", "--min_test_sequences=5"],
+     "--min_test_sequences"),
     ("build_dataset", ["--data_dir={tmp}/data", "--raw_dir={file}"], "--raw_dir"),
     ("build_dataset", ["--data_dir={tmp}/data", "extra"], "unexpected arguments"),
     # record_pushes

@@ -96,6 +96,8 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
 
     Args:
       seed: dataset seed; a seed other than 0 builds ``<config>_seed<seed>`` next to the seed-0 datasets.
+      min_test_sequences: 0, or the config's test splits grown to this many sequences, a test-only dataset
+        ``<config>_test<N>`` (``pushjax.data.configs.plan_grown_test_splits``).
       raw_dir: root of a raw (MIT layout) folder to read the sequences from, read-only: building raises
         :class:`IncompleteRawDirError` (counting the missing files, naming the first) unless it holds every file
         the config plans, and never writes into it. None (default): pushjax's own cache
@@ -123,20 +125,22 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
     BUILDER_CONFIGS = [_builder_config(dataset) for dataset in configs.all_configs()]
     DEFAULT_CONFIG_NAME = f"data_efficiency_{configs.DEFAULT_SCALE}"
 
-    def __init__(self, *, seed: int = 0, raw_dir: str | os.PathLike | None = None, workers: int | None = None,
-                 progress: bool = True, **kwargs):
-        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-            raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
+    def __init__(self, *, seed: int = 0, min_test_sequences: int = 0, raw_dir: str | os.PathLike | None = None,
+                 workers: int | None = None, progress: bool = True, **kwargs):
+        for name, value in (("seed", seed), ("min_test_sequences", min_test_sequences)):
+            if not isinstance(value, int) or isinstance(value, bool) or value < 0:
+                raise ValueError(f"{name}: expected an integer >= 0, got {value!r}")
         if workers is not None and (not isinstance(workers, int) or workers < 1):
             raise ValueError(f"workers: expected an integer >= 1, got {workers!r}")
         config = kwargs.get("config") or self.DEFAULT_CONFIG_NAME
-        if seed:
+        if seed or min_test_sequences:
             name = config if isinstance(config, str) else config.dataset.name
             base = {c.name: c for c in self.BUILDER_CONFIGS}.get(name)
             if base is None:
                 raise ValueError(f"config: expected one of {', '.join(c.name for c in self.BUILDER_CONFIGS)}, "
                                  f"got {name!r}")
-            kwargs["config"] = _builder_config(dataclasses.replace(base.dataset, seed=seed))
+            kwargs["config"] = _builder_config(dataclasses.replace(base.dataset, seed=seed,
+                                                                   min_test_sequences=min_test_sequences))
         kwargs.setdefault("file_format", "array_record")
         super().__init__(**kwargs)
         self._raw_dir = Path(raw_dir) if raw_dir is not None else (
@@ -433,7 +437,8 @@ def config_name(experiment: str, scale: str = configs.DEFAULT_SCALE, testbed: st
 
 def build(experiment: str, scale: str = configs.DEFAULT_SCALE, data_dir: str | os.PathLike | None = None,
           seed: int = 0, testbed: str = DEFAULT_PROFILE, workers: int | None = None, progress: bool = True,
-          raw_dir: str | os.PathLike | None = None, beam_runner=None, beam_options=None) -> PushEffects:
+          raw_dir: str | os.PathLike | None = None, beam_runner=None, beam_options=None,
+          min_test_sequences: int = 0) -> PushEffects:
     """Builds (or finds) one dataset and returns its builder; see :class:`PushEffects` for the arguments.
 
     ``testbed`` names the testbed profile (``pushjax.sim.testbed.PROFILES``). ``beam_runner`` (a runner or its
@@ -442,28 +447,31 @@ def build(experiment: str, scale: str = configs.DEFAULT_SCALE, data_dir: str | o
     whether it reused a finished dataset or built it, with the dataset's name, version and folder.
     """
     builder = PushEffects(config=config_name(experiment, scale, testbed), data_dir=data_dir, seed=seed,
-                          workers=workers, progress=progress, raw_dir=raw_dir)
+                          min_test_sequences=min_test_sequences, workers=workers, progress=progress, raw_dir=raw_dir)
     reused = builder.is_prepared()
     builder.download_and_prepare(download_config=tfds.download.DownloadConfig(beam_runner=beam_runner,
                                                                             beam_options=beam_options))
-    logging.info("dataset %s version %s: %s %s", dataset_name(experiment, scale, seed, testbed), builder.version,
+    logging.info("dataset %s version %s: %s %s", dataset_name(experiment, scale, seed, testbed, min_test_sequences),
+                 builder.version,
                  "reused from" if reused else "built in", builder.data_dir)
     return builder
 
 
 def dataset_name(experiment: str, scale: str = configs.DEFAULT_SCALE, seed: int = 0,
-                 testbed: str = DEFAULT_PROFILE) -> str:
-    """The ``tfds.data_source`` name of a dataset, e.g. ``push_effects/data_efficiency_cpu`` or
-    ``push_effects/data_efficiency_cpu_ideal/seed=3``."""
-    return f"{DATASET_NAME}/{config_name(experiment, scale, testbed)}" + (f"/seed={seed}" if seed else "")
+                 testbed: str = DEFAULT_PROFILE, min_test_sequences: int = 0) -> str:
+    """The ``tfds.data_source`` name of a dataset, e.g. ``push_effects/data_efficiency_cpu``,
+    ``push_effects/data_efficiency_cpu_ideal/seed=3`` or ``push_effects/velocities_cpu/min_test_sequences=150``."""
+    kwargs = [f"{name}={value}" for name, value in (("seed", seed), ("min_test_sequences", min_test_sequences))
+              if value]
+    return f"{DATASET_NAME}/{config_name(experiment, scale, testbed)}" + (f"/{','.join(kwargs)}" if kwargs else "")
 
 
 def load(experiment: str, scale: str = configs.DEFAULT_SCALE, data_dir: str | os.PathLike | None = None,
-         seed: int = 0, testbed: str = DEFAULT_PROFILE, split: str | None = None):
+         seed: int = 0, testbed: str = DEFAULT_PROFILE, split: str | None = None, min_test_sequences: int = 0):
     """The built dataset's ``tfds.data_source``: split name -> random-access source (or one source for ``split``).
 
     Each element is a dict of NumPy arrays with the fields of ``pushjax.data.schema.FIELDS`` plus
     ``pushjax.data.examples.EXTRA_FIELDS``. Nothing is built: a missing dataset raises.
     """
-    return tfds.data_source(dataset_name(experiment, scale, seed, testbed), data_dir=data_dir, split=split,
-                            download=False)
+    return tfds.data_source(dataset_name(experiment, scale, seed, testbed, min_test_sequences), data_dir=data_dir,
+                            split=split, download=False)

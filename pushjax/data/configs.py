@@ -64,6 +64,11 @@ assumes) is the clean reference, its datasets named ``<experiment>_<scale>_ideal
 
 All numbers that define a dataset live in :class:`DatasetConfig`; ``get_config(experiment, scale, seed, testbed)``
 returns the one used by the builders.
+
+Grown test splits (issue 30): ``get_config(..., min_test_sequences=N)`` is a test-only dataset, named
+``<experiment>_<scale>..._test<N>``: each test split of the experiment's dataset, its sequences kept, grown by further
+draws of the pools it tests to at least N sequences (``plan_grown_test_splits``). Trained models are evaluated on it
+(``--min_test_sequences`` of the experiment binaries); their training and validation splits are untouched.
 """
 
 from __future__ import annotations
@@ -134,6 +139,8 @@ class DatasetConfig:
         camera's table point, m.
       max_rotation: scene rotations are uniform in [-max_rotation, max_rotation], rad.
       repeated_start_time: window start of the ``repeated`` examples, s.
+      min_test_sequences: 0: the experiment's dataset. N > 0: a test-only dataset holding the experiment's test
+        splits, each grown to at least N sequences (see :func:`plan_grown_test_splits`).
     """
 
     experiment: str
@@ -156,6 +163,7 @@ class DatasetConfig:
     max_translation: float = 0.04
     max_rotation: float = math.pi
     repeated_start_time: float = 0.5
+    min_test_sequences: int = 0
 
     def __post_init__(self):
         if self.experiment not in EXPERIMENTS:
@@ -177,12 +185,18 @@ class DatasetConfig:
                 raise ValueError(f"{name}: expected a fraction in [0, 1), got {getattr(self, name)!r}")
         if not self.horizon > 0:
             raise ValueError(f"horizon: expected > 0 s, got {self.horizon!r}")
+        if not isinstance(self.min_test_sequences, int) or self.min_test_sequences < 0:
+            raise ValueError(f"min_test_sequences: expected an integer >= 0, got {self.min_test_sequences!r}")
+        if self.min_test_sequences and self.experiment == "repeated":
+            raise ValueError("min_test_sequences: the repeated experiment tests one push; expected 0")
 
     @property
     def name(self) -> str:
-        """The TFDS config name: ``<experiment>_<scale>``, with ``_<testbed>`` for a testbed other than the default
-        and ``_seed<seed>`` for seeds other than 0 (e.g. ``data_efficiency_smoke_ideal_seed3``)."""
+        """The TFDS config name: ``<experiment>_<scale>``, with ``_<testbed>`` for a testbed other than the default,
+        ``_test<N>`` for grown test splits and ``_seed<seed>`` for seeds other than 0 (e.g.
+        ``data_efficiency_smoke_ideal_seed3``, ``velocities_cpu_test150``)."""
         return (f"{self.experiment}_{self.scale}" + (f"_{self.testbed}" if self.testbed != DEFAULT_PROFILE else "")
+                + (f"_test{self.min_test_sequences}" if self.min_test_sequences else "")
                 + (f"_seed{self.seed}" if self.seed else ""))
 
     @property
@@ -224,8 +238,9 @@ _EXPERIMENT_SIZES = {
 
 
 def get_config(experiment: str, scale: str = DEFAULT_SCALE, seed: int = 0,
-               testbed: str = DEFAULT_PROFILE) -> DatasetConfig:
-    """The configuration of ``experiment`` at ``scale`` (see the module docstring) with ``seed`` and ``testbed``."""
+               testbed: str = DEFAULT_PROFILE, min_test_sequences: int = 0) -> DatasetConfig:
+    """The configuration of ``experiment`` at ``scale`` (see the module docstring) with ``seed`` and ``testbed``;
+    ``min_test_sequences`` > 0: its test splits grown to that many sequences, as a test-only dataset."""
     if scale not in _SIZES:
         raise ValueError(f"scale: expected one of {', '.join(SCALES)}, got {scale!r}")
     sizes = dict(_SIZES[scale], **_EXPERIMENT_SIZES.get((experiment, scale), {}))
@@ -234,7 +249,8 @@ def get_config(experiment: str, scale: str = DEFAULT_SCALE, seed: int = 0,
     if experiment == "repeated":
         sizes["windows_per_sequence"] = 1
         sizes["no_contact_fraction"] = 0.0
-    return DatasetConfig(experiment=experiment, scale=scale, seed=seed, testbed=testbed, **sizes)
+    return DatasetConfig(experiment=experiment, scale=scale, seed=seed, testbed=testbed,
+                         min_test_sequences=min_test_sequences, **sizes)
 
 
 def all_configs(seed: int = 0) -> list[DatasetConfig]:
@@ -294,6 +310,12 @@ def contact_point_id(params: PushParams) -> int:
     return params.side * len(points) + int(np.argmin(np.abs(points - params.point)))
 
 
+def is_new_push(params: PushParams, config: DatasetConfig) -> bool:
+    """Whether a push belongs to the ``new_pushes`` test: at a held-out angle or a held-out contact point."""
+    at_held_angle = bool(np.any(np.abs(np.radians(NEW_PUSH_TEST_ANGLES_DEG) - params.angle) < 1e-3))
+    return at_held_angle or contact_point_id(params) in held_out_contact_points(params.shape, config)
+
+
 Jobs = dict[str, list[PushJob]]
 """Split name -> the recording jobs of its sequences."""
 
@@ -317,13 +339,10 @@ def _held_out_pushes(config: DatasetConfig, raw_dir: Path) -> Jobs:
 def _new_pushes(config: DatasetConfig, raw_dir: Path) -> Jobs:
     """``new_pushes``: pushes at held-out angles or contact points are the test split."""
     jobs: Jobs = {"train": [], "validation": [], "test": []}
-    held_angles = np.radians(NEW_PUSH_TEST_ANGLES_DEG)
     for obj in OBJECT_NAMES:
         pool = _pool(obj, TRAIN_VELOCITY, config.pushes_per_object, config, raw_dir)
         rng = np.random.default_rng(_key(config.seed, obj, config.experiment, "split"))
-        held_points = held_out_contact_points(obj, config)
-        is_test = [bool(np.any(np.abs(held_angles - job.params.angle) < 1e-3))
-                   or contact_point_id(job.params) in held_points for job in pool]
+        is_test = [is_new_push(job.params, config) for job in pool]
         jobs["test"] += [job for job, test in zip(pool, is_test) if test]
         train, validation = _split_off([job for job, test in zip(pool, is_test) if not test],
                                        config.validation_fraction, rng)
@@ -393,6 +412,52 @@ SPLIT_PLANS: dict[str, Callable[[DatasetConfig, Path], Jobs]] = {
 """Experiment -> how its sequences are planned and split (one entry per name of `EXPERIMENTS`)."""
 
 
+_TEST_MEMBERSHIP: dict[str, Callable[[PushParams, DatasetConfig], bool]] = {"new_pushes": is_new_push}
+"""Experiment -> which pushes its test splits may hold, where not every push may (default: any)."""
+
+
+def plan_grown_test_splits(config: DatasetConfig, raw_dir: str | Path) -> Jobs:
+    """The test splits of ``config``'s experiment, each grown to at least ``config.min_test_sequences`` sequences.
+
+    A test split keeps its sequences and gains, for each (object, surface, velocity) it tests, further draws of
+    that pool (the next pushes of `pushjax.sim.dataset.plan_pushes`' deterministic order, at ``new_pushes`` only
+    pushes its test admits) until each of these groups holds ``ceil(min_test_sequences / groups)``. No added
+    sequence belongs to any split of the experiment's own dataset, so a model trained on that dataset has seen
+    none of them.
+
+    Raises:
+      ValueError: naming the object, surface and velocity whose MIT grid has too few distinct pushes left.
+    """
+    own = SPLIT_PLANS[config.experiment](dataclasses.replace(config, min_test_sequences=0), Path(raw_dir))
+    taken = {job.path for jobs in own.values() for job in jobs}
+    admits = _TEST_MEMBERSHIP.get(config.experiment, lambda params, config: True)
+    grown: Jobs = {}
+    for name, jobs in own.items():
+        if not name.startswith("test"):
+            continue
+        groups = sorted({(job.params.shape, job.params.surface, job.params.velocity) for job in jobs})
+        per_group = math.ceil(config.min_test_sequences / len(groups))
+        grown[name] = list(jobs)
+        for obj, surface, velocity in groups:
+            missing = per_group - sum((job.params.shape, job.params.surface, job.params.velocity)
+                                      == (obj, surface, velocity) for job in jobs)
+            draws = missing + sum(job.params.shape == obj and job.params.velocity == velocity
+                                  and job.params.surface == surface for jobs in own.values() for job in jobs)
+            while missing > 0:
+                draws = min(draws, _distinct_pushes(obj))
+                fresh = [job for job in _pool(obj, velocity, draws, config, Path(raw_dir))
+                         if job.params.surface == surface and job.path not in taken and admits(job.params, config)]
+                if len(fresh) >= missing:
+                    grown[name] += fresh[:missing]
+                    taken.update(job.path for job in fresh[:missing])
+                    break
+                if draws == _distinct_pushes(obj):
+                    raise ValueError(f"min_test_sequences: {obj} on {surface} at {velocity:g} mm/s has {len(fresh)} "
+                                     f"pushes left for {name}, {missing} needed for {config.min_test_sequences}")
+                draws += missing - len(fresh)
+    return grown
+
+
 def plan_splits(config: DatasetConfig, raw_dir: str | Path) -> SplitPlan:
     """The sequences of ``config``'s dataset and their assignment to splits; deterministic for the config.
 
@@ -400,7 +465,8 @@ def plan_splits(config: DatasetConfig, raw_dir: str | Path) -> SplitPlan:
       config: the dataset.
       raw_dir: root of the raw (MIT layout) cache of the simulated sequences (of ``config.testbed``).
     """
-    per_split = SPLIT_PLANS[config.experiment](config, Path(raw_dir))
+    per_split = (plan_grown_test_splits(config, raw_dir) if config.min_test_sequences
+                 else SPLIT_PLANS[config.experiment](config, Path(raw_dir)))
     by_path = {job.path: job for jobs in per_split.values() for job in jobs}
     paths = sorted(by_path)
     ids = {path: index for index, path in enumerate(paths)}

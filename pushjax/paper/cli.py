@@ -31,6 +31,9 @@ WORKERS = flags.DEFINE_integer("workers", None, "Dataset build processes (defaul
 MODE = flags.DEFINE_enum("mode", None, SWEEP_MODES, "Sweep batching (default: sequential on CPU, else vmap).")
 VARIANTS_FLAG = flags.DEFINE_list("variants", [], "Models to train and baselines (default: the experiment's).")
 TESTBED = flags.DEFINE_enum("testbed", testbed.DEFAULT_PROFILE, list(testbed.PROFILES), testbed.FLAG_HELP)
+MIN_TEST_SEQUENCES = flags.DEFINE_integer(
+    "min_test_sequences", 0, "Evaluate on the test splits grown to at least this many push sequences, a test-only "
+    "dataset that shares no sequence with the training and validation splits (0: the experiment's own test splits).")
 COORDINATOR_ADDRESS = flags.DEFINE_string(
     "coordinator_address", None, "Several processes (hosts): host:port of process 0, which coordinates them.")
 NUM_PROCESSES = flags.DEFINE_integer("num_processes", 1, "Processes (one per host) that train together.")
@@ -61,7 +64,7 @@ def spec_from_flags(setup: spec_lib.Setup) -> spec_lib.ExperimentSpec:
         spec = spec_lib.make_spec(
             setup, SCALE.value, models=VARIANTS_FLAG.value, sizes=SIZES.value, seeds=SEEDS.value,
             num_steps=NUM_STEPS.value, data_dir=DATA_DIR.value, build=BUILD.value, workers=WORKERS.value,
-            mode=MODE.value, testbed=TESTBED.value,
+            mode=MODE.value, testbed=TESTBED.value, min_test_sequences=MIN_TEST_SEQUENCES.value,
             config_overrides={path: flag.value for path, flag in CONFIG_OVERRIDES.items() if flag.value is not None},
         )
     except ValueError as error:

@@ -99,10 +99,11 @@ def load_splits(spec: ExperimentSpec, dataset: data.DatasetConfig, progress: boo
     `DatasetUnavailableError` before building anything when `dataset` is missing and ``spec.build`` is off, or when
     it is missing and its data directory is not writable.
     """
+    identity = dict(seed=dataset.seed, testbed=dataset.testbed, min_test_sequences=dataset.min_test_sequences)
     builder = data.PushEffects(config=data.config_name(dataset.experiment, dataset.scale, dataset.testbed),
-                               data_dir=spec.data_dir, seed=dataset.seed)
+                               data_dir=spec.data_dir, seed=dataset.seed, min_test_sequences=dataset.min_test_sequences)
     if not builder.is_prepared():
-        name = data.dataset_name(dataset.experiment, dataset.scale, dataset.seed, dataset.testbed)
+        name = data.dataset_name(dataset.experiment, dataset.scale, **identity)
         if not spec.build:
             raise DatasetUnavailableError(f"build: dataset {name} is not built (looked in {builder.data_dir}) and --nobuild "
                              "forbids building it; --build builds it there")
@@ -112,11 +113,10 @@ def load_splits(spec: ExperimentSpec, dataset: data.DatasetConfig, progress: boo
             message = f"dataset {name} is not built and cannot be built in {builder.data_dir_root}: {error}"
             raise DatasetUnavailableError(f"data_dir: {message}") from None
     if train_lib.distributed.is_writer():  # with several processes, process 0 builds and the others wait
-        data.build(dataset.experiment, dataset.scale, data_dir=spec.data_dir, seed=dataset.seed,
-                   testbed=dataset.testbed, workers=spec.workers, progress=progress)
+        data.build(dataset.experiment, dataset.scale, data_dir=spec.data_dir, workers=spec.workers, progress=progress,
+                   **identity)
     train_lib.distributed.wait_for_all(f"dataset {builder.builder_config.name} ready")
-    return data.load(dataset.experiment, dataset.scale, data_dir=spec.data_dir, seed=dataset.seed,
-                     testbed=dataset.testbed)
+    return data.load(dataset.experiment, dataset.scale, data_dir=spec.data_dir, **identity)
 
 
 def _split_sources(splits: Mapping, names: Sequence[str], dataset: data.DatasetConfig) -> list:

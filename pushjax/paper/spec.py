@@ -151,7 +151,7 @@ class ExperimentSpec:
 
     def test_split_label(self, split: str) -> str:
         """The name of a test split in results: ``<experiment>/<split>`` when it is not the training dataset's."""
-        return split if self.test_dataset == self.dataset else f"{self.test_dataset.experiment}/{split}"
+        return split if self.test_dataset.experiment == self.dataset.experiment else f"{self.test_dataset.experiment}/{split}"
 
     def to_json(self) -> dict:
         """The spec as the ``config`` of ``results.json``, in JSON's own types (lists, not tuples)."""
@@ -239,6 +239,7 @@ def make_spec(
     sizes: Sequence[int | str] = (), seeds: Sequence[int | str] = (0,), num_steps: int | None = None,
     data_dir: str | os.PathLike | None = None, build: bool = True, workers: int | None = None,
     mode: str | None = None, testbed: str = DEFAULT_PROFILE, config_overrides: Mapping[str, str] | None = None,
+    min_test_sequences: int = 0,
 ) -> ExperimentSpec:
     """The `ExperimentSpec` of `setup` with the user's choices; raises ``ValueError`` naming a bad one.
 
@@ -256,6 +257,8 @@ def make_spec(
       testbed: the testbed profile the datasets are simulated with (`pushjax.sim.testbed.PROFILES`).
       config_overrides: training-config fields replaced after the scale's config and `num_steps`, as text
         (`pushjax.train.configs.override`: ``{"learning_rate": "3e-4", "model.head_features": "64,32"}``).
+      min_test_sequences: 0, or evaluate on the test splits grown to this many sequences, a dataset of their own
+        that shares no sequence with the training and validation splits (`pushjax.data.configs.get_config`).
     """
     models = parse_models(models or setup.models)
     sizes = parse_sizes(sizes or setup.sizes)
@@ -269,8 +272,10 @@ def make_spec(
     if workers is not None and workers < 1:
         raise ValueError(f"workers: expected a positive integer, got {workers}")
     dataset = data_configs.get_config(setup.experiment, scale, testbed=testbed)
-    test_dataset = (data_configs.get_config(setup.test_experiment, scale, testbed=testbed) if setup.test_experiment
-                    else dataset)
+    test_dataset = dataset
+    if setup.test_experiment or min_test_sequences:
+        test_dataset = data_configs.get_config(setup.test_experiment or setup.experiment, scale, testbed=testbed,
+                                               min_test_sequences=min_test_sequences)
     train = train_configs.get_config(dataset)
     train = dataclasses.replace(train, num_steps=num_steps or train.num_steps)
     train = train_configs.override(train, config_overrides or {})

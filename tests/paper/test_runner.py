@@ -1,10 +1,14 @@
 """The orchestrator's reports: which dataset a run reads, what its progress bars name, and its record of each sitting."""
 
+import dataclasses
 import datetime
 import json
 import logging
 import shutil
 
+import numpy as np
+
+from pushjax import data
 from pushjax.data.builder import RAW_DIR_NAME
 from pushjax.paper import runner
 from pushjax.paper import spec as spec_lib
@@ -32,6 +36,33 @@ def test_load_splits_says_where_it_built_a_dataset(smoke_data, tmp_path, caplog)
     [message] = [record.getMessage() for record in caplog.records if record.getMessage().startswith("dataset push_effects")]
     assert message.startswith("dataset push_effects/repeated_smoke version 3.0.0: built in ")
     assert str(tmp_path) in message
+
+
+def test_grown_test_splits_hold_the_test_examples_and_unseen_pushes(smoke_data, tmp_path, caplog):
+    # The smoke test split (11 sequences) grown to 22 from the suite's raw cache: only the 11 added pushes simulate.
+    shutil.copytree(smoke_data("data_efficiency") / RAW_DIR_NAME, tmp_path / RAW_DIR_NAME)
+    spec = spec_lib.make_spec(spec_lib.SETUPS["data_efficiency"], "smoke", data_dir=tmp_path, min_test_sequences=22)
+    with caplog.at_level(logging.INFO, logger="absl"):
+        [(name, grown)] = runner.load_splits(spec, spec.test_dataset, progress=False).items()
+    assert any(record.getMessage().startswith(
+        "dataset push_effects/data_efficiency_smoke/min_test_sequences=22 version 3.0.0: built in ")
+        for record in caplog.records)
+    own = runner.load_splits(dataclasses.replace(spec, data_dir=str(smoke_data("data_efficiency")), build=False),
+                             spec.dataset, progress=False)["test"]
+    own_plan, grown_plan = (data.plan_splits(config, "/unused") for config in (spec.dataset, spec.test_dataset))
+    own_ids = {own_plan.jobs[i].path: i for i in own_plan.splits["test"]}
+    grown_to_own = {i: own_ids.get(grown_plan.jobs[i].path) for i in grown_plan.splits["test"]}
+    assert name == "test" and len(grown_to_own) == 22 and sum(i is not None for i in grown_to_own.values()) == 11
+    examples = [grown[i] for i in range(len(grown))]
+    assert len(examples) == 22 * spec.test_dataset.examples_per_sequence
+    kept = [example for example in examples if grown_to_own[int(example["sequence_id"])] is not None]
+    originals = [own[i] for i in range(len(own))]
+    assert len(kept) == len(originals)
+    for example, original in zip(kept, originals):  # both in the order of their sequences' paths
+        assert grown_to_own[int(example["sequence_id"])] == int(original["sequence_id"])
+        for field in original:
+            if field != "sequence_id":
+                np.testing.assert_array_equal(example[field], original[field], err_msg=field)
 
 
 def test_progress_labels_name_the_variants_sizes_and_seeds():

@@ -44,6 +44,15 @@ def test_visualize_tests_on_the_repeated_push():
     assert spec.to_json()["test_dataset"]["experiment"] == "repeated"
 
 
+def test_grown_test_splits_are_a_test_only_dataset_of_the_same_experiment():
+    spec = spec_lib.make_spec(spec_lib.SETUPS["velocities"], "smoke", testbed="ideal", min_test_sequences=40)
+    assert spec.dataset.name == "velocities_smoke_ideal" and spec.test_dataset.name == "velocities_smoke_ideal_test40"
+    assert spec.test_split_label("test_20") == "test_20"
+    assert spec.to_json()["test_dataset"]["min_test_sequences"] == 40
+    with pytest.raises(ValueError, match="^min_test_sequences: the repeated experiment tests one push"):
+        spec_lib.make_spec(spec_lib.SETUPS["visualize"], "smoke", min_test_sequences=40)
+
+
 def test_datasets_are_simulated_on_the_realistic_testbed_unless_ideal_is_chosen():
     default = spec_lib.make_spec(spec_lib.SETUPS["visualize"], "smoke")
     assert default.dataset.testbed == default.test_dataset.testbed == default.to_json()["testbed"] == "realistic"
@@ -73,6 +82,7 @@ def test_to_json_is_strict_json_and_keeps_the_variant_per_row():
     (dict(workers=0), "workers"),
     (dict(data_dir="/nonexistent/pushjax"), "data_dir"),
     (dict(testbed="lab"), "testbed"),
+    (dict(min_test_sequences=-1), "min_test_sequences"),
 ])
 def test_bad_choices_name_what_is_wrong(choices, message):
     with pytest.raises(ValueError, match=f"^{message}: "):
