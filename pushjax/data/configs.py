@@ -73,6 +73,7 @@ draws of the pools it tests to at least N sequences (``plan_grown_test_splits``)
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 import math
 import zlib
@@ -416,6 +417,11 @@ _TEST_MEMBERSHIP: dict[str, Callable[[PushParams, DatasetConfig], bool]] = {"new
 """Experiment -> which pushes its test splits may hold, where not every push may (default: any)."""
 
 
+def _pool_of(job: PushJob) -> tuple[str, str, float]:
+    """(object, surface, velocity): the pool a push is drawn from."""
+    return job.params.shape, job.params.surface, job.params.velocity
+
+
 def plan_grown_test_splits(config: DatasetConfig, raw_dir: str | Path) -> Jobs:
     """The test splits of ``config``'s experiment, each grown to at least ``config.min_test_sequences`` sequences.
 
@@ -429,20 +435,19 @@ def plan_grown_test_splits(config: DatasetConfig, raw_dir: str | Path) -> Jobs:
       ValueError: naming the object, surface and velocity whose MIT grid has too few distinct pushes left.
     """
     own = SPLIT_PLANS[config.experiment](dataclasses.replace(config, min_test_sequences=0), Path(raw_dir))
-    taken = {job.path for jobs in own.values() for job in jobs}
+    planned = collections.Counter(_pool_of(job) for split_jobs in own.values() for job in split_jobs)
+    taken = {job.path for split_jobs in own.values() for job in split_jobs}
     admits = _TEST_MEMBERSHIP.get(config.experiment, lambda params, config: True)
     grown: Jobs = {}
     for name, jobs in own.items():
         if not name.startswith("test"):
             continue
-        groups = sorted({(job.params.shape, job.params.surface, job.params.velocity) for job in jobs})
-        per_group = math.ceil(config.min_test_sequences / len(groups))
+        tested = collections.Counter(_pool_of(job) for job in jobs)
+        per_group = math.ceil(config.min_test_sequences / len(tested))
         grown[name] = list(jobs)
-        for obj, surface, velocity in groups:
-            missing = per_group - sum((job.params.shape, job.params.surface, job.params.velocity)
-                                      == (obj, surface, velocity) for job in jobs)
-            draws = missing + sum(job.params.shape == obj and job.params.velocity == velocity
-                                  and job.params.surface == surface for jobs in own.values() for job in jobs)
+        for obj, surface, velocity in sorted(tested):
+            missing = per_group - tested[obj, surface, velocity]
+            draws = missing + planned[obj, surface, velocity]
             while missing > 0:
                 draws = min(draws, _distinct_pushes(obj))
                 fresh = [job for job in _pool(obj, velocity, draws, config, Path(raw_dir))
