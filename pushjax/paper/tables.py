@@ -177,8 +177,10 @@ def markdown(results: Mapping) -> str:
     testbed = config.get("testbed", "ideal")  # results written before testbed profiles existed are ideal's
     trained = [row for row in rows if row["kind"] == "trained"]
     sizes = sorted({row["train_size"] for row in trained})
+    grown = config.get("test_dataset", {}).get("min_test_sequences")
     title = (f"# {name} ({config['experiment']} dataset, {config['scale']} scale, {testbed} testbed, "
-             f"seeds {config['seeds']})\n\n" + _STATISTICS_NOTE)
+             f"seeds {config['seeds']}" + (f"; test splits grown to at least {grown} sequences" if grown else "")
+             + ")\n\n" + _STATISTICS_NOTE)
     if reference.tables():
         title += (f"A *paper* column gives the paper's value of the cell to its left, where the paper has one; "
                   f"our largest training size ({max(sizes, default='–')}) stands for the paper's largest.\n\n")

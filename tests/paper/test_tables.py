@@ -74,3 +74,12 @@ def test_tables_without_the_papers_file_have_no_paper_column(tmp_path, monkeypat
     assert reference.tables() == {}
     table = tables.markdown(_data_efficiency_results())
     assert "paper" not in table.replace("pushjax.paper", "")
+
+
+def test_the_title_says_when_the_test_splits_were_grown():
+    results = _data_efficiency_results()
+    assert "grown" not in tables.markdown(results)
+    results["config"]["test_dataset"] = {"experiment": "data_efficiency", "min_test_sequences": 150}
+    assert tables.markdown(results).startswith(
+        "# data_efficiency (data_efficiency dataset, cpu scale, realistic testbed, seeds [0]; "
+        "test splits grown to at least 150 sequences)\n")
