@@ -41,7 +41,8 @@ def test_load_splits_says_where_it_built_a_dataset(smoke_data, tmp_path, caplog)
 def test_grown_test_splits_hold_the_test_examples_and_unseen_pushes(smoke_data, tmp_path, caplog):
     # The smoke test split (11 sequences) grown to 22 from the suite's raw cache: only the 11 added pushes simulate.
     shutil.copytree(smoke_data("data_efficiency") / RAW_DIR_NAME, tmp_path / RAW_DIR_NAME)
-    spec = spec_lib.make_spec(spec_lib.SETUPS["data_efficiency"], "smoke", data_dir=tmp_path, min_test_sequences=22)
+    spec = spec_lib.make_spec(spec_lib.SETUPS["data_efficiency"], "smoke", data_dir=tmp_path, min_test_sequences=22,
+                              workers=1)
     with caplog.at_level(logging.INFO, logger="absl"):
         [(name, grown)] = runner.load_splits(spec, spec.test_dataset, progress=False).items()
     assert any(record.getMessage().startswith(
