@@ -452,8 +452,7 @@ def build(experiment: str, scale: str = configs.DEFAULT_SCALE, data_dir: str | o
     builder.download_and_prepare(download_config=tfds.download.DownloadConfig(beam_runner=beam_runner,
                                                                             beam_options=beam_options))
     logging.info("dataset %s version %s: %s %s", dataset_name(experiment, scale, seed, testbed, min_test_sequences),
-                 builder.version,
-                 "reused from" if reused else "built in", builder.data_dir)
+                 builder.version, "reused from" if reused else "built in", builder.data_dir)
     return builder
 
 

@@ -151,7 +151,8 @@ class ExperimentSpec:
 
     def test_split_label(self, split: str) -> str:
         """The name of a test split in results: ``<experiment>/<split>`` when it is not the training dataset's."""
-        return split if self.test_dataset.experiment == self.dataset.experiment else f"{self.test_dataset.experiment}/{split}"
+        experiment = self.test_dataset.experiment
+        return split if experiment == self.dataset.experiment else f"{experiment}/{split}"
 
     def to_json(self) -> dict:
         """The spec as the ``config`` of ``results.json``, in JSON's own types (lists, not tuples)."""
