@@ -5,7 +5,7 @@
 #
 # MIN_TEST_SEQUENCES=150 evaluates every experiment on its test splits grown to at least 150 push sequences
 # (`--min_test_sequences`; the same training and validation data, so the same models as without it); give it its
-# own RUNS_DIR and PUBLISHED_DIR (e.g. results/test150).
+# own RUNS_DIR and PUBLISHED_DIR (e.g. results/test150). Fig. 8 (visualize, one repeated push) is not run again then.
 #
 # Resumable: stop it at any time and run it again. Training resumes from each sweep's last checkpoint, and an
 # experiment this script finished is not run again. A finished experiment's tables, curves and figures (results.json,
@@ -52,9 +52,12 @@ share() {  # share FROM TO SWEEP...: copy finished sweeps of experiment FROM int
 }
 
 run data_efficiency
-# visualize only evaluates data_efficiency's sweeps: run it while they are still in RUNS_DIR.
-share data_efficiency visualize train/l1/neural train/l1/hybrid train/l1/simple train/l1/error
-run visualize --sizes=2500,190000 --min_test_sequences=0  # its test split is one repeated push
+# visualize only evaluates data_efficiency's sweeps: run it while they are still in RUNS_DIR. Its test split is one
+# repeated push, which no MIN_TEST_SEQUENCES grows.
+if [[ "$min_test" == 0 ]]; then
+  share data_efficiency visualize train/l1/neural train/l1/hybrid train/l1/simple train/l1/error
+  run visualize --sizes=2500,190000
+fi
 share data_efficiency error_variants train/l1/hybrid train/l1/error_error_grad_error_norm
 run viewpoint
 run error_variants
