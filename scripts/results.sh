@@ -4,7 +4,7 @@
 #   bash scripts/results.sh [RUNS_DIR]      (default: work/results; SEEDS=0,1,2 and SCALE=cpu by default)
 #
 # MIN_TEST_SEQUENCES=150 evaluates every experiment on its test splits grown to at least 150 push sequences
-# (`--min_test_sequences`; the same training and validation data, so the same models as without it); give it its
+# (`--min_test_sequences`; the same training and validation data, seeds and schedule as without it); give it its
 # own RUNS_DIR and PUBLISHED_DIR (e.g. results/test150). Fig. 8 (visualize, one repeated push) is not run again then.
 #
 # Resumable: stop it at any time and run it again. Training resumes from each sweep's last checkpoint, and an
