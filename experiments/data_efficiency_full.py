@@ -2,7 +2,8 @@ r"""Table 1 at the paper's composition and sizes, each model trained to converge
 
   python -m experiments.data_efficiency_full --workdir=results/data_efficiency_full --data_dir=work/data \
       [--scale=cpu_full|paper_full] [--sizes=2500,5000,10000,20000,50000,100000,190080] [--seeds=0,1,2] [--nowide] \
-      [--max_models=N] [--deadline=2026-11-26T11:00] [--models_at_once=2] [--criterion=eval_every=1000;window=5]
+      [--max_models=N] [--deadline=2026-11-26T11:00] [--models_at_once=2] [--criterion=eval_every=1000;window=5] \
+      [--only=neural_190080_seed0_wide,hybrid_190080_seed0_wide]
 
 Without --scale, --sizes and --seeds: cpu_full, the sizes above and seeds 0, 1 and 2 (paper_full: the same pushes
 at the paper's images and widths, for a GPU: benchmarks/paper_full_gpu.sh) (the shared flags of
@@ -34,6 +35,8 @@ _MAX_MODELS = flags.DEFINE_integer("max_models", None, "Train at most this many 
 _DEADLINE = flags.DEFINE_string("deadline", None, "Start no model after this UTC time (ISO 8601, e.g. 2026-11-26T11:00).")
 _MODELS_AT_ONCE = flags.DEFINE_integer("models_at_once", 2, "Models trained at the same time (threads sharing the "
                                        "training split; the records do not depend on it).", lower_bound=1)
+_ONLY = flags.DEFINE_list("only", None, "Train only these models of the plan (their keys, e.g. "
+                          "hybrid_190080_seed0_wide), in this order: e.g. the slowest ones on a lent GPU.")
 _CRITERION = flags.DEFINE_string("criterion", "", "Overrides of the convergence criterion, 'name=value;...' (tests).")
 
 
@@ -87,6 +90,11 @@ def main(argv):
             raise app.UsageError(f"--deadline: expected an ISO 8601 time, got {_DEADLINE.value!r}") from None
     criterion = criterion_from_flag(_CRITERION.value)
     units = full_run.plan(sizes, seeds, side_sizes, _WIDE.value)
+    if _ONLY.value is not None:
+        try:
+            units = full_run.select(units, _ONLY.value)
+        except ValueError as error:
+            raise app.UsageError(f"--only: {error}") from None
 
     def publish(results):
         tables.write(results, workdir)

@@ -92,6 +92,15 @@ def plan(sizes: Sequence[int] = SIZES, seeds: Sequence[int] = SEEDS, side_sizes:
     return units
 
 
+def select(units: Sequence[Unit], keys: Sequence[str]) -> list[Unit]:
+    """The `units` named by `keys`, in the order of `keys`; raises ``ValueError`` naming a key not among them."""
+    by_key = {unit.key: unit for unit in units}
+    unknown = [key for key in keys if key not in by_key]
+    if unknown:
+        raise ValueError(f"{', '.join(unknown)} not in the plan; its models are {', '.join(by_key)}")
+    return [by_key[key] for key in dict.fromkeys(keys)]
+
+
 def setup(sizes: Sequence[int] = SIZES) -> spec_lib.Setup:
     return spec_lib.Setup(NAME, "data_efficiency", (*MAIN_VARIANTS, *SIDE_VARIANTS, "zero", "physics"),
                           sizes=tuple(sizes))
@@ -211,8 +220,17 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Traini
         "parameters": int(sum(np.size(leaf) for leaf in jax.tree.leaves(trained.state.params))),
         "train_seconds": round(trained.seconds, 1), "eval_seconds": round(time.monotonic() - clock, 1),
         "steps_per_second": trained.steps_per_second, "started": started.isoformat(timespec="seconds"),
+        "device": device_description(),
         **({"commit": commit} if (commit := paths.git_commit()) else {}),
     })
+
+
+def device_description() -> dict:
+    """What trained a model: JAX's platform and device kind, and the precision of float32 matrix products (the
+    GPU's default, TF32, is coarser than the CPU's)."""
+    device = jax.devices()[0]
+    return {"platform": device.platform, "kind": device.device_kind,
+            "matmul_precision": str(jax.config.jax_default_matmul_precision or "default")}
 
 
 def baseline_rows(spec: spec_lib.ExperimentSpec, test: Mapping) -> list[dict]:

@@ -29,6 +29,15 @@ def test_plan_covers_the_issue():
     assert [unit.key for unit in units if unit.wide] == ["neural_190080_seed0_wide", "hybrid_190080_seed0_wide"]
 
 
+def test_select_keeps_the_given_order_and_names_unknown_keys():
+    units = full_run.plan()
+    wide = ["hybrid_190080_seed0_wide", "neural_190080_seed0_wide"]
+    assert [unit.key for unit in full_run.select(units, wide + wide[:1])] == wide
+    assert all(unit.wide for unit in full_run.select(units, wide))
+    with pytest.raises(ValueError, match="neural_190080_seed7 not in the plan; its models are neural_2500_seed0"):
+        full_run.select(units, ["neural_190080_seed7"])
+
+
 def test_results_of_the_records(smoke_results):
     workdir = smoke_results("data_efficiency_full")
     results = json.loads((workdir / "results.json").read_text())
@@ -113,11 +122,14 @@ def test_bad_criterion_and_deadline(tmp_path):
         run_binary("data_efficiency_full", f"--workdir={tmp_path}", "--criterion=window=x")
     with pytest.raises(app.UsageError, match="--deadline"):
         run_binary("data_efficiency_full", f"--workdir={tmp_path}", "--deadline=soon")
+    with pytest.raises(app.UsageError, match="--only: simple_50000_seed0 not in the plan"):
+        run_binary("data_efficiency_full", f"--workdir={tmp_path}", "--only=simple_50000_seed0")
 
 
 def test_a_recorded_model_loads_from_the_run_and_scores_as_recorded(smoke_results, smoke_data):
     workdir = smoke_results("data_efficiency_full")
     record = json.loads((workdir / "models" / "hybrid_80_seed0.json").read_text())
+    assert record["device"] == {"platform": "cpu", "kind": "cpu", "matmul_precision": "default"}
     predictor = load_model(workdir, model="hybrid_80_seed0")
     assert predictor.variant == "hybrid" and predictor.name == "size=80/seed=0"
     assert predictor.checkpoint == (workdir / full_run.CHECKPOINTS / "hybrid_80_seed0", record["row"]["steps"])
