@@ -6,8 +6,8 @@
 # Builds data_efficiency at scale paper_full (cpu_full's pushes, splits and examples rendered at 128 x 128 px, 80 x 80
 # px glimpses; the build on the CPU cores with JAX kept off the GPU), then trains neural and hybrid at SIZE training
 # examples, seeds 0, 1 and 2, at the paper's widths by issue 30's convergence criterion
-# (experiments.data_efficiency_full --scale=paper_full): no model starts after three quarters of SECONDS, and training
-# stops at SECONDS. Models recorded in RECORDS (default results/data_efficiency_paper_full/models, the committed ones)
+# (experiments.data_efficiency_full --scale=paper_full): no model starts after START_BY seconds (default three quarters
+# of SECONDS), and training stops at SECONDS. Models recorded in RECORDS (default results/data_efficiency_paper_full/models, the committed ones)
 # are not trained again. Writes OUT_DIR/build.log, OUT_DIR/dataset.sha256 (the built files' digests, to compare with
 # a build elsewhere), OUT_DIR/train.log and OUT_DIR/records.tgz (the finished models' records, the training state of
 # the unfinished ones in in_training/, results.json and results.md; cut into OUT_DIR/records.tgz.part-* of 15 MiB
@@ -42,7 +42,7 @@ tail -3 "$out/build.log"
 [ $status -eq 0 ] || exit $status
 (cd "$data" && sha256sum push_effects/*/*/*array_record*) > "$out/dataset.sha256"
 
-deadline=$(date -u -d "@$(( start + seconds * 3 / 4 ))" +%Y-%m-%dT%H:%M:%S)
+deadline=$(date -u -d "@$(( start + ${START_BY:-$(( seconds * 3 / 4 ))} ))" +%Y-%m-%dT%H:%M:%S)
 timeout $(( seconds - $(since) )) "$python" -m experiments.data_efficiency_full --scale="$scale" --sizes="$size" \
   --seeds="${SEEDS:-0,1,2}" --nowide --max_models="${MODELS:-6}" --models_at_once=2 --deadline="$deadline" --workdir="$work" \
   --data_dir="$data" ${ARGS:-} > "$out/train.log" 2>&1
