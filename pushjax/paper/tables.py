@@ -198,6 +198,7 @@ def markdown(results: Mapping) -> str:
             *([convergence_table([row for row in results["rows"] if row["kind"] == "trained"],
                                  results["config"].get("criterion"))]
               if any("converged" in row for row in trained) else []),
+            *([widths] if (widths := widths_table(results["rows"])) else []),
         ]) + "\n"
     if name in ("velocities", "error_velocities", "objects"):
         figure = {"velocities": "Fig. 6", "error_velocities": "Fig. 9", "objects": "Fig. 7"}[name]
@@ -245,6 +246,50 @@ def convergence_table(trained: Sequence[Mapping], criterion: Mapping | None) -> 
             cells.append(f"{met}/{len(members)} met, {steps:,.0f} steps")
         lines.append(f"| {model} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def widths_table(rows: Sequence[Mapping]) -> str:
+    """Issue 30's check of the head's widths: for each ``<variant>_wide`` model (the paper's widths, one seed), its
+    difference from the variant at our widths with the same seed and size, and neural − hybrid at both widths and its
+    change, paired over the test sequences; beside them neural − hybrid at our widths over all its seeds. Empty
+    without wide rows."""
+    trained = [row for row in rows if row.get("kind") == "trained"]
+    wide = {row["model"].removesuffix("_wide"): row for row in trained if row["model"].endswith("_wide")}
+    if not wide:
+        return ""
+    size, seed = next(iter(wide.values()))["train_size"], next(iter(wide.values()))["seed"]
+    narrow = {row["model"]: row for row in trained
+              if row["train_size"] == size and row["seed"] == seed and row["model"] in wide}
+
+    def one(row, metric):
+        return statistics.estimate([row], metric)
+
+    def seeds_of(model, metric):
+        return statistics.estimate([row for row in trained if row["model"] == model and row["train_size"] == size],
+                                   metric)
+
+    comparisons = []
+    for variant in wide:
+        if variant in narrow:
+            comparisons.append((f"{variant}_wide − {variant}",
+                                lambda metric, v=variant: statistics.difference(one(wide[v], metric),
+                                                                                one(narrow[v], metric))))
+    if {"neural", "hybrid"} <= wide.keys() & narrow.keys():
+        def gap(models, metric):
+            return statistics.difference(one(models["neural"], metric), one(models["hybrid"], metric))
+        comparisons += [
+            (f"neural − hybrid, our widths (seed {seed})", lambda metric: gap(narrow, metric)),
+            (f"neural − hybrid, the paper's widths (seed {seed})", lambda metric: gap(wide, metric)),
+            ("change of neural − hybrid (paper's − ours)",
+             lambda metric: statistics.difference(gap(wide, metric), gap(narrow, metric))),
+            ("neural − hybrid, our widths (all seeds)",
+             lambda metric: statistics.difference(seeds_of("neural", metric), seeds_of("hybrid", metric))),
+        ]
+    metrics = ("trans_percent", "rot_percent", statistics.SCORE)
+    body = [[label] + [str(compare(metric)) for metric in metrics] for label, compare in comparisons]
+    return (f"## The paper's widths at {size} training examples\n\nDifferences in % of zero, ± the standard error "
+            f"paired over the test sequences (one seed each: the seeds' spread is only in the last row); score: the "
+            f"mean of translation and rotation.\n\n" + _markdown(["comparison", "trans. [%]", "rot. [%]", "score"], body))
 
 
 def write(results: Mapping, workdir: str | os.PathLike) -> Path:

@@ -83,3 +83,27 @@ def test_the_title_says_when_the_test_splits_were_grown():
     assert tables.markdown(results).startswith(
         "# data_efficiency (data_efficiency dataset, cpu scale, realistic testbed, seeds [0]; "
         "test splits grown to at least 150 sequences)\n")
+
+
+def _sequence_row(model, seed, trans_mm):
+    """A trained row at 190 080 examples whose 4 test sequences each had a zero-motion error of 10 mm and 10°."""
+    count = len(trans_mm)
+    sequences = {"id": list(range(count)), "count": [1] * count, "trans_mm": trans_mm, "trans_zero_mm": [10.0] * count,
+                 "rot_deg": [2 * value for value in trans_mm], "rot_zero_deg": [10.0] * count}
+    trans = 10.0 * sum(trans_mm) / count
+    return {**_row(model, 190080, seed, trans, 1.0), "rot_percent": 2 * trans, "sequences": sequences}
+
+
+def test_the_widths_table_pairs_the_wide_models_with_their_twins():
+    rows = [_sequence_row("neural", 0, [3.0, 2.0, 2.0, 1.0]), _sequence_row("hybrid", 0, [2.0, 2.0, 2.0, 2.0]),
+            _sequence_row("neural", 1, [2.0, 2.0, 2.0, 2.0]), _sequence_row("hybrid", 1, [2.0, 2.0, 2.0, 2.0]),
+            _sequence_row("neural_wide", 0, [4.0, 2.0, 2.0, 2.0]), _sequence_row("hybrid_wide", 0, [1.0] * 4)]
+    table = tables.widths_table(rows)
+    lines = {line.split(" | ")[0].removeprefix("| "): line for line in table.splitlines() if line.startswith("| ")}
+    # neural_wide - neural: 25 - 20 % in translation, paired over the sequences.
+    assert lines["neural_wide − neural"].startswith("| neural_wide − neural | 5.0 ± ")
+    # neural − hybrid: 20 - 20 at our widths, 25 - 10 at the paper's widths; the change is their difference.
+    assert lines["neural − hybrid, our widths (seed 0)"].startswith("| neural − hybrid, our widths (seed 0) | 0.0 ± ")
+    assert "widths (seed 0) | 15.0 ± " in lines["neural − hybrid, the paper's widths (seed 0)"]
+    assert "(paper's − ours) | 15.0 ± " in lines["change of neural − hybrid (paper's − ours)"]
+    assert tables.widths_table([row for row in rows if not row["model"].endswith("_wide")]) == ""
