@@ -4,7 +4,9 @@ For every (model, size) with seeds recorded in both work directories (e.g. ``pap
 ``benchmarks/paper_full_gpu.sh`` against the ``cpu_full`` run): each run's mean over those seeds and the difference
 ``first - second`` with its standard error. Where both runs evaluated the same test sequences (``paper_full`` renders
 ``cpu_full``'s pushes), the difference is paired over sequences (`pushjax.paper.statistics.difference`); the seeds'
-part is the spread of each run's seeds, taken as independent.
+part is the spread of each run's seeds, taken as independent. The same compares the GPU twins of the ``cpu_full``
+run (``results/data_efficiency_full/h200``: models trained on a lent H200 with its own build of the dataset) with the
+run's own models: what the device changes.
 
     python benchmarks/paper_full_compare.py results/data_efficiency_paper_full results/data_efficiency_full
 """

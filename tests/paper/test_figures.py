@@ -50,4 +50,9 @@ def test_fig5_of_the_full_run_shows_the_papers_end_points(tmp_path, monkeypatch)
     figures.plot({"name": "data_efficiency_full", "rows": rows}, tmp_path)
     labels = drawn[0].axes[0].get_legend_handles_labels()[1]
     assert sorted(labels) == ["neural", "neural (paper)"]
-    assert sorted(tick.get_text() for tick in drawn[0].axes[0].get_xticklabels()) == ["190,000", "2,500", "20,000"]
+    assert [tick.get_text() for tick in drawn[0].axes[0].get_xticklabels()] == ["2.5k", "20k", "190k"]
+
+
+def test_log_ticks_merge_sizes_within_five_percent():
+    assert figures._log_ticks({2500.0, 190080.0, 190000.0, 500.0}) == ([500.0, 2500.0, 190000.0],
+                                                                       ["500", "2.5k", "190k"])
