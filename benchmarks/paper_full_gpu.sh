@@ -7,8 +7,8 @@
 # px glimpses; the build on the CPU cores with JAX kept off the GPU), then trains neural and hybrid at SIZE training
 # examples, seeds 0, 1 and 2, at the paper's widths by issue 30's convergence criterion
 # (experiments.data_efficiency_full --scale=paper_full): no model starts after START_BY seconds (default three quarters
-# of SECONDS), and training stops at SECONDS. Models recorded in RECORDS (default results/data_efficiency_paper_full/models, the committed ones)
-# are not trained again. Writes OUT_DIR/build.log, OUT_DIR/dataset.sha256 (the built files' digests, to compare with
+# of SECONDS), and training stops at SECONDS. Models recorded in RECORDS (default
+# results/data_efficiency_paper_full/models, the committed ones) are not trained again. Writes OUT_DIR/build.log, OUT_DIR/dataset.sha256 (the built files' digests, to compare with
 # a build elsewhere), OUT_DIR/train.log and OUT_DIR/records.tgz (the finished models' records, the training state of
 # the unfinished ones in in_training/, results.json and results.md; cut into OUT_DIR/records.tgz.part-* of 15 MiB
 # when larger, for the device tool's 16 MiB a file). Environment: PYTHON (default python3), DATA_DIR, WORKDIR
