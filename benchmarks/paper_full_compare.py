@@ -42,6 +42,9 @@ def main(first: str, second: str) -> None:
         for metric, decimals in METRICS.items():
             first_estimate, second_estimate = (statistics.estimate([run[key]["row"] for key in keys], metric)
                                                for run in records)
+            if first_estimate is None or second_estimate is None:  # a metric the model has not (neural_dyn: pos_mm)
+                parts += ["–"] * 3
+                continue
             difference = statistics.difference(first_estimate, second_estimate)
             paired = " (paired)" if difference.replicates is not None else ""
             parts += [_text(first_estimate, decimals), _text(second_estimate, decimals),
