@@ -257,7 +257,7 @@ def widths_table(rows: Sequence[Mapping]) -> str:
     wide = {row["model"].removesuffix("_wide"): row for row in trained if row["model"].endswith("_wide")}
     if not wide:
         return ""
-    size, seed = next(iter(wide.values()))["train_size"], next(iter(wide.values()))["seed"]
+    size, seed = (next(iter(wide.values()))[key] for key in ("train_size", "seed"))
     narrow = {row["model"]: row for row in trained
               if row["train_size"] == size and row["seed"] == seed and row["model"] in wide}
 
