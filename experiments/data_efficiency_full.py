@@ -3,11 +3,22 @@ r"""Table 1 at the paper's composition and sizes, each model trained to converge
   python -m experiments.data_efficiency_full --workdir=results/data_efficiency_full --data_dir=work/data \
       [--scale=cpu_full|paper_full] [--sizes=2500,5000,10000,20000,50000,100000,190080] [--seeds=0,1,2] [--nowide] \
       [--max_models=N] [--deadline=2026-11-26T11:00] [--models_at_once=2] [--criterion=eval_every=1000;window=5] \
-      [--only=neural_190080_seed0_wide,hybrid_190080_seed0_wide]
+      [--only=neural_190080_seed0_wide,hybrid_190080_seed0_wide] [--variants=neural,hybrid,error]
+      [--schedule=criterion|paper] [--steps=75000]
+
+The paper's training instead of the criterion (``--schedule=paper``: Adam at a constant 10^-4, batch 32, --steps
+steps, no early stop, the validation score recorded every 1 000 steps; `pushjax.train.convergence.PAPER_SCHEDULE`),
+e.g. the long-trained models of Table 1 at the full split:
+
+  python -m experiments.data_efficiency_full --workdir=results/data_efficiency_long --data_dir=work/data \
+      --schedule=paper --sizes=190080 --variants=neural,hybrid,error --nowide
+
+A model of that schedule keeps its training state in ``<workdir>/in_training/``, so the same command with a larger
+--steps continues its recorded models to the new length.
 
 Without --scale, --sizes and --seeds: cpu_full, the sizes above and seeds 0, 1 and 2 (paper_full: the same pushes
 at the paper's images and widths, for a GPU: benchmarks/paper_full_gpu.sh) (the shared flags of
-`pushjax.paper.cli`; --variants, --num_steps, --mode and the multi-process flags are not used here).
+`pushjax.paper.cli`; --num_steps, --mode and the multi-process flags are not used here).
 
 Trains every model of `pushjax.paper.full_run.plan` that has no record in ``<workdir>/models/`` (neural, hybrid and
 error at every size, simple and neural_dyn at 2 500, 20 000 and the full split, 3 seeds, neural and hybrid at the
@@ -38,10 +49,15 @@ _MODELS_AT_ONCE = flags.DEFINE_integer("models_at_once", 2, "Models trained at t
 _ONLY = flags.DEFINE_list("only", None, "Train only these models of the plan (their keys, e.g. "
                           "hybrid_190080_seed0_wide), in this order: e.g. the slowest ones on a lent GPU.")
 _CRITERION = flags.DEFINE_string("criterion", "", "Overrides of the convergence criterion, 'name=value;...' (tests).")
+_SCHEDULE = flags.DEFINE_enum("schedule", "criterion", ["criterion", "paper"],
+                              "criterion: the convergence criterion; paper: the paper's constant 1e-4 for --steps steps, "
+                              "no early stop.")
+_STEPS = flags.DEFINE_integer("steps", convergence.PAPER_STEPS, "Steps of --schedule=paper (a multiple of 1000).",
+                              lower_bound=1)
 
 
-def criterion_from_flag(text: str) -> convergence.Criterion:
-    """`convergence.CRITERION` with the overrides of ``--criterion``; raises ``app.UsageError`` naming a bad one."""
+def criterion_from_flag(text: str, base: convergence.Criterion = convergence.CRITERION) -> convergence.Criterion:
+    """`base` with the overrides of ``--criterion``; raises ``app.UsageError`` naming a bad one."""
     fields = {field.name: field.type for field in dataclasses.fields(convergence.Criterion)}
     overrides = {}
     for item in filter(None, (part.strip() for part in text.split(";"))):
@@ -49,11 +65,16 @@ def criterion_from_flag(text: str) -> convergence.Criterion:
         if name not in fields:
             raise app.UsageError(f"--criterion: unknown field {name!r}; choose from {', '.join(fields)}")
         try:
-            overrides[name] = float(value) if fields[name] == "float" else int(value)
+            if fields[name] == "bool":
+                if value not in ("true", "false"):
+                    raise ValueError(value)
+                overrides[name] = value == "true"
+            else:
+                overrides[name] = float(value) if fields[name] == "float" else int(value)
         except ValueError:
             raise app.UsageError(f"--criterion: {name} expects a {fields[name]}, got {value!r}") from None
     try:
-        return dataclasses.replace(convergence.CRITERION, **overrides)
+        return dataclasses.replace(base, **overrides)
     except ValueError as error:
         raise app.UsageError(f"--criterion: {error}") from None
 
@@ -78,8 +99,10 @@ def main(argv):
         sizes = spec_lib.parse_sizes(cli.SIZES.value) if given("sizes") else full_run.SIZES
         side_sizes = spec_lib.parse_sizes(_SIDE_SIZES.value)
         seeds = spec_lib.parse_seeds(cli.SEEDS.value) if given("seeds") else full_run.SEEDS
+        paper = _SCHEDULE.value == "paper"
         spec = full_run.make_spec(cli.DATA_DIR.value, sizes=sizes, seeds=seeds, scale=scale, build=cli.BUILD.value,
-                                  workers=cli.WORKERS.value)
+                                  workers=cli.WORKERS.value, paper_training=paper)
+        units = full_run.plan(sizes, seeds, side_sizes, _WIDE.value, cli.VARIANTS_FLAG.value or None)
     except ValueError as error:
         raise app.UsageError(f"--{error}") from error
     deadline = None
@@ -88,8 +111,13 @@ def main(argv):
             deadline = datetime.datetime.fromisoformat(_DEADLINE.value).replace(tzinfo=datetime.timezone.utc)
         except ValueError:
             raise app.UsageError(f"--deadline: expected an ISO 8601 time, got {_DEADLINE.value!r}") from None
-    criterion = criterion_from_flag(_CRITERION.value)
-    units = full_run.plan(sizes, seeds, side_sizes, _WIDE.value)
+    base = convergence.CRITERION
+    if _SCHEDULE.value == "paper":
+        try:
+            base = convergence.fixed_budget(_STEPS.value)
+        except ValueError as error:
+            raise app.UsageError(f"--{error}") from None
+    criterion = criterion_from_flag(_CRITERION.value, base)
     if _ONLY.value is not None:
         try:
             units = full_run.select(units, _ONLY.value)

@@ -81,14 +81,21 @@ class Unit:
 
 
 def plan(sizes: Sequence[int] = SIZES, seeds: Sequence[int] = SEEDS, side_sizes: Sequence[int] = SIDE_SIZES,
-         wide: bool = True) -> list[Unit]:
-    """Every model of the run in the order it trains: by size, then variant, then seed; the wide models last."""
+         wide: bool = True, variants: Sequence[str] | None = None) -> list[Unit]:
+    """Every model of the run in the order it trains: by size, then variant, then seed; the wide models last.
+    With `variants`, only the models of those variants."""
     units = []
     for size in sizes:
-        variants = MAIN_VARIANTS + (SIDE_VARIANTS if size in side_sizes else ())
-        units += [Unit(variant, size, seed) for variant in variants for seed in seeds]
+        size_variants = MAIN_VARIANTS + (SIDE_VARIANTS if size in side_sizes else ())
+        units += [Unit(variant, size, seed) for variant in size_variants for seed in seeds]
     if wide:
         units += [Unit(variant, max(sizes), seeds[0], wide=True) for variant in WIDE_VARIANTS]
+    if variants is not None:
+        unknown = sorted(set(variants) - {*MAIN_VARIANTS, *SIDE_VARIANTS})
+        if unknown:
+            raise ValueError(f"variants: {', '.join(unknown)} not trained by this run; choose from "
+                             f"{', '.join((*MAIN_VARIANTS, *SIDE_VARIANTS))}")
+        units = [unit for unit in units if unit.variant in variants]
     return units
 
 
@@ -107,10 +114,24 @@ def setup(sizes: Sequence[int] = SIZES) -> spec_lib.Setup:
 
 
 def make_spec(data_dir: str | None = None, *, sizes: Sequence[int] = SIZES, seeds: Sequence[int] = SEEDS,
-              scale: str = SCALE, build: bool = True, workers: int | None = None) -> spec_lib.ExperimentSpec:
-    """The run's `ExperimentSpec` (``sequential`` mode: each model is trained on its own, not stacked with others)."""
+              scale: str = SCALE, build: bool = True, workers: int | None = None,
+              paper_training: bool = False) -> spec_lib.ExperimentSpec:
+    """The run's `ExperimentSpec` (``sequential`` mode: each model is trained on its own, not stacked with others);
+    with `paper_training`, the paper's learning rate and batch size replace the scale's
+    (`pushjax.train.convergence.PAPER_SCHEDULE`'s models)."""
+    overrides = None if not paper_training else {"learning_rate": repr(convergence.PAPER_LEARNING_RATE),
+                                                 "batch_size": str(convergence.PAPER_BATCH_SIZE)}
     return spec_lib.make_spec(setup(sizes), scale, sizes=sizes, seeds=seeds, data_dir=data_dir, build=build,
-                              workers=workers, mode="sequential")
+                              workers=workers, mode="sequential", config_overrides=overrides)
+
+
+def needs_training(unit: Unit, done: Mapping[str, dict], criterion: convergence.Criterion, split_size: int) -> bool:
+    """Whether `unit` has no record in `done`, or, with a fixed budget, a record of fewer steps than the budget (it is
+    continued from its kept training state)."""
+    record = done.get(unit.key)
+    if record is None:
+        return True
+    return not criterion.stop_on_plateau and record["row"]["steps"] < criterion.budget(min(unit.size, split_size))
 
 
 def _compact(value):
@@ -293,7 +314,8 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
     test = train_lib.examples_from_source(splits["test"], fields)
     if not (workdir / "baselines.json").exists():
         _write_json(workdir / "baselines.json", _compact(baseline_rows(spec, test)))
-    todo = [unit for unit in units if unit.key not in records(workdir)]
+    done = records(workdir)
+    todo = [unit for unit in units if needs_training(unit, done, criterion, len(splits["train"]))]
     log(f"{NAME}: {len(units) - len(todo)} of {len(units)} models recorded in {workdir}/models, {len(todo)} to train")
     if todo and (max_models is None or max_models > 0):
         validation = train_lib.examples_from_source(splits["validation"], fields)
@@ -318,7 +340,8 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
                     raise
                 with written:
                     _write_json(workdir / "models" / f"{unit.key}.json", record)
-                    shutil.rmtree(workdir / IN_TRAINING / unit.key)
+                    if criterion.stop_on_plateau:  # a fixed budget keeps its state, to be continued further
+                        shutil.rmtree(workdir / IN_TRAINING / unit.key)
                     row = record["row"]
                     log(f"{NAME}: recorded {unit.key}: {row['steps']} steps "
                         f"({'converged' if row['converged'] else 'budget'}), test trans {row['trans_percent']:.1f} % "

@@ -13,6 +13,11 @@ with the training-set size) ends first, the model is *not converged*. Either way
 learning rate to `Criterion.final_lr_fraction` of it follows (`Criterion.decay_steps`: a tenth of the constant
 phase, at least `Criterion.min_decay_steps`), and the model after the decay is the one evaluated.
 
+**A fixed budget** (`Criterion.stop_on_plateau` False, e.g. `PAPER_SCHEDULE`): the validation score is recorded every
+`Criterion.eval_every` steps and used for nothing; the constant phase lasts the whole budget, with no decay when
+`decay_fraction` and `min_decay_steps` are 0. Such a model can be continued to a larger budget from its saved state:
+a call with the same `resume_dir` and a criterion with a larger budget reopens the constant phase where it ended.
+
 One model per call: the unit of work of a resumable run whose finished models are recorded as they finish
 (`pushjax.paper.full_run`). With a `resume_dir` the model's training state, its scores and the criterion's progress
 are saved every `Criterion.eval_every` steps (constant phase and decay), and a call with the same folder continues
@@ -50,6 +55,8 @@ class Criterion:
 
     Attributes:
       eval_every: steps between validation scores.
+      stop_on_plateau: whether the criterion ends the constant phase (False: a fixed budget; the scores are recorded
+        only).
       window: evaluations without a relative improvement of more than `min_improvement` that end the phase.
       min_improvement: relative improvement of the best validation score that counts (0.01: 1 %).
       base_steps: the budget of constant-rate steps at size 0 ...
@@ -61,6 +68,7 @@ class Criterion:
     """
 
     eval_every: int = 1_000
+    stop_on_plateau: bool = True
     window: int = 5
     min_improvement: float = 0.01
     base_steps: int = 10_000
@@ -71,9 +79,11 @@ class Criterion:
     final_lr_fraction: float = 0.01
 
     def __post_init__(self):
-        for name in ("eval_every", "window", "base_steps", "max_steps", "min_decay_steps"):
+        for name in ("eval_every", "window", "base_steps", "max_steps"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name}: expected a positive integer, got {getattr(self, name)}")
+        if self.min_decay_steps < 0:
+            raise ValueError(f"min_decay_steps: expected a non-negative integer, got {self.min_decay_steps}")
         for name in ("min_improvement", "decay_fraction", "final_lr_fraction"):
             if not 0.0 <= getattr(self, name) < 1.0:
                 raise ValueError(f"{name}: expected a fraction in [0, 1), got {getattr(self, name)}")
@@ -85,7 +95,7 @@ class Criterion:
 
     def plateaued(self, scores: Sequence[float]) -> bool:
         """Whether validation `scores` (one per evaluation, lower is better) have stopped improving."""
-        if len(scores) <= self.window:
+        if not self.stop_on_plateau or len(scores) <= self.window:
             return False
         before, recent = min(scores[:-self.window]), min(scores[-self.window:])
         return recent > before * (1.0 - self.min_improvement)
@@ -96,6 +106,22 @@ class Criterion:
 
 CRITERION = Criterion()
 """The criterion of the ``data_efficiency_full`` run, fixed before it."""
+
+PAPER_STEPS = 75_000
+PAPER_LEARNING_RATE = 1e-4
+PAPER_BATCH_SIZE = 32
+PAPER_SCHEDULE = Criterion(stop_on_plateau=False, base_steps=PAPER_STEPS, steps_per_example=0.0,
+                           max_steps=PAPER_STEPS, decay_fraction=0.0, min_decay_steps=0)
+"""The paper's training (``paper_tables.json``'s ``training``: Adam at a constant `PAPER_LEARNING_RATE`, batch
+`PAPER_BATCH_SIZE`, `PAPER_STEPS` steps, no early stop), scored every 1 000 steps; `fixed_budget` gives it another
+length."""
+
+
+def fixed_budget(steps: int) -> Criterion:
+    """`PAPER_SCHEDULE` with `steps` constant-rate steps (rounded up to a multiple of its ``eval_every``)."""
+    if steps < 1:
+        raise ValueError(f"steps: expected a positive integer, got {steps}")
+    return dataclasses.replace(PAPER_SCHEDULE, base_steps=steps, max_steps=steps)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -201,6 +227,9 @@ def train_until_converged(
     checkpointer = None if resume_dir is None else Checkpointer(resume_dir, max_to_keep=1)
     if checkpointer is not None and (restored := checkpointer.restore_latest(state)) is not None:
         step, state, progress = restored
+        if not criterion.stop_on_plateau and progress["constant_steps"] is not None \
+                and progress["constant_steps"] < budget and step == progress["constant_steps"]:
+            progress = {**progress, "constant_steps": None}  # a fixed budget continued to a larger one
     scores: list[float] = list(progress["scores"])
     history: list[tuple[int, float, float]] = [tuple(point) for point in progress["validation"]]
     converged, constant_steps = bool(progress["converged"]), progress["constant_steps"]
@@ -256,7 +285,8 @@ def train_until_converged(
     finally:
         if checkpointer is not None:
             checkpointer.close()
-    score_now("after the decay", {"loss": float(metrics["loss"])} if metrics is not None else {})
+    if decay_steps or not history or history[-1][0] != step:
+        score_now("after the decay", {"loss": float(metrics["loss"])} if metrics is not None else {})
     return ConvergedModel(model, state, converged, constant_steps, decay_steps, history,
                           progress["seconds"] + time.monotonic() - started,
                           step / train_seconds if train_seconds > 0 else float("nan"))

@@ -141,3 +141,23 @@ def test_a_recorded_model_loads_from_the_run_and_scores_as_recorded(smoke_result
         assert scores[key] == pytest.approx(record["row"][key], rel=1e-5)
     with pytest.raises(ValueError, match=r"model: .* one checkpoint folder per model; expected one of \[.*'neural_40_seed0'"):
         load_model(workdir, model="hybrid_99_seed0")
+
+
+def test_the_paper_schedule_trains_a_fixed_budget_and_continues_it(smoke_data, tmp_path):
+    workdir = tmp_path / "long"
+    arguments = (*SMOKE, f"--data_dir={smoke_data('data_efficiency')}", f"--workdir={workdir}", "--sizes=80",
+                 "--seeds=0", "--variants=neural", "--nowide", "--schedule=paper", "--criterion=eval_every=5")
+    run_binary("data_efficiency_full", *arguments, "--steps=10")
+    record = json.loads((workdir / "models" / "neural_80_seed0.json").read_text())
+    assert record["row"]["steps"] == 10 and record["row"]["decay_steps"] == 0 and record["row"]["converged"] is False
+    assert [point["step"] for point in record["validation"]] == [5, 10]
+    results = json.loads((workdir / "results.json").read_text())
+    assert results["config"]["train"]["learning_rate"] == 1e-4 and results["config"]["train"]["batch_size"] == 32
+    assert results["config"]["criterion"]["stop_on_plateau"] is False
+    assert (workdir / full_run.IN_TRAINING / "neural_80_seed0").is_dir()  # kept, to be continued
+    run_binary("data_efficiency_full", *arguments, "--steps=20")
+    continued = json.loads((workdir / "models" / "neural_80_seed0.json").read_text())
+    assert continued["row"]["steps"] == 20 and continued["validation"][:2] == record["validation"]
+    assert [point["step"] for point in continued["validation"]] == [5, 10, 15, 20]
+    with pytest.raises(app.UsageError, match="--variants: simpel not trained by this run"):
+        run_binary("data_efficiency_full", f"--workdir={tmp_path}", "--variants=simpel")

@@ -1,5 +1,7 @@
 """The convergence criterion of issue 30's run, and one model trained by it on the smoke data."""
 
+import dataclasses
+
 import jax
 import numpy as np
 import pytest
@@ -91,3 +93,31 @@ def test_a_resumed_model_ends_as_an_uninterrupted_one(smoke, tmp_path, monkeypat
     for got, expected in zip(jax.tree.leaves(resumed.state), jax.tree.leaves(whole.state), strict=True):
         np.testing.assert_array_equal(got, expected)
     assert convergence.resumed_step(tmp_path / "nothing") == 0
+
+
+def test_a_fixed_budget_ignores_the_scores_and_continues_to_a_larger_one(smoke, tmp_path):
+    examples, validation = smoke["train"], smoke["validation"]
+    spec = ModelSpec("size=64/seed=2", np.arange(64), seed=2)
+    # min_improvement=0.9 would stop the criterion at its first chance; a fixed budget records the scores only.
+    short = dataclasses.replace(convergence.fixed_budget(10), eval_every=5, min_improvement=0.9)
+    long = dataclasses.replace(short, base_steps=20, max_steps=20)
+    assert convergence.PAPER_SCHEDULE.budget(190_080) == 75_000 and convergence.PAPER_SCHEDULE.decay_steps(75_000) == 0
+    whole = convergence.train_until_converged(TINY_SMOKE, examples, spec, validation, long)
+    assert (whole.converged, whole.constant_steps, whole.decay_steps) == (False, 20, 0)
+    assert [step for step, *_ in whole.validation] == [5, 10, 15, 20]
+    learning_rate = float(whole.state.opt_state.hyperparams["learning_rate"])
+    assert learning_rate == pytest.approx(TINY_SMOKE.learning_rate)  # no decay
+    folder = tmp_path / "state"
+    first = convergence.train_until_converged(TINY_SMOKE, examples, spec, validation, short, resume_dir=folder)
+    assert first.steps == 10 and [step for step, *_ in first.validation] == [5, 10]
+    lines = []
+    continued = convergence.train_until_converged(TINY_SMOKE, examples, spec, validation, long, log=lines.append,
+                                                  resume_dir=folder)
+    assert [line.split(": ", 1)[1] for line in lines] == [
+        f"step {step} (constant) validation score {(trans + rot) / 2:.2f}" for step, trans, rot in whole.validation[2:]]
+    assert continued.validation == whole.validation and continued.steps == 20
+    for got, expected in zip(jax.tree.leaves(continued.state), jax.tree.leaves(whole.state), strict=True):
+        np.testing.assert_array_equal(got, expected)
+    # The same budget again trains nothing and scores nothing.
+    again = convergence.train_until_converged(TINY_SMOKE, examples, spec, validation, long, resume_dir=folder)
+    assert again.validation == whole.validation and again.steps == 20
