@@ -78,13 +78,14 @@ class TrendRule:
         if not 0.5 < self.confidence < 1.0:
             raise ValueError(f"confidence: expected in (0.5, 1), got {self.confidence}")
 
-    def trend(self, steps: Sequence[int], scores: Sequence[float]) -> Trend | None:
+    def trend(self, steps: Sequence[int], scores: Sequence[float], require_span: bool = True) -> Trend | None:
         """The trend of the evaluations (`steps`, `scores`: [n], in order) in the window that ends at the last one;
-        None when the evaluations do not yet span the window or are fewer than `min_evaluations`."""
+        None when the evaluations do not yet span the window (with `require_span`) or are fewer than
+        `min_evaluations`."""
         steps, scores = np.asarray(steps, np.float64), np.asarray(scores, np.float64)
         if steps.shape != scores.shape or steps.ndim != 1:
             raise ValueError(f"steps and scores: expected two [n] arrays, got {steps.shape} and {scores.shape}")
-        if len(steps) == 0 or steps[-1] - steps[0] < self.window_steps:
+        if len(steps) == 0 or (require_span and steps[-1] - steps[0] < self.window_steps):
             return None
         inside = steps >= steps[-1] - self.window_steps
         x, y = steps[inside], scores[inside]
@@ -112,6 +113,10 @@ class TrendRule:
                 return int(steps[end - 1])
         return None
 
+
+IMPROVING = TrendRule(window_steps=10_000, min_evaluations=5)
+"""Whether a curve still falls at its end: the trend of its last 10 000 steps (at least 5 evaluations; the window need
+not be spanned), improving when its one-sided 95 % lower bound on the gain is above 0 (`Trend.gain_lower`)."""
 
 RULE = TrendRule()
 """The rule, fixed before the long-trained models of Table 1 were read: `long_run_continues` applies it at 75 000

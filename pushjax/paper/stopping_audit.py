@@ -1,0 +1,95 @@
+"""Which models of a convergence-criterion run the trend rule would have kept training.
+
+The ``data_efficiency_full`` run stopped each model when the best of its last five validation scores was not 1 %
+better than the best before them (`pushjax.train.convergence.CRITERION`). `audit` replays every recorded model's
+validation curve (its constant-rate phase) under `pushjax.train.stopping.RULE` and says, at the step the criterion
+stopped it:
+
+* ``improving``: the trend of its last 10 000 steps still falls (`pushjax.train.stopping.IMPROVING`: the one-sided
+  95 % lower bound on the gain above zero) -- a model stopped while improving;
+* ``rule_stops``: the trend rule would have stopped there too (its upper bound on the gain below 0.5 points per
+  10 000 steps); ``too_short``: fewer steps than the rule's window, so it could not have stopped yet;
+* ``first_stop``: the first evaluation at which the rule stops within the recorded curve (None: never).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from collections.abc import Mapping
+from pathlib import Path
+
+from pushjax.paper import full_run
+from pushjax.train import stopping
+
+
+def audit_record(record: Mapping, rule: stopping.TrendRule = stopping.RULE) -> dict:
+    """One model's row: its key, variant, size, seed, the criterion's stop and the trend rule's verdict there."""
+    row = record["row"]
+    stop = row["constant_steps"]
+    curve = [(point["step"], (point["trans_percent"] + point["rot_percent"]) / 2.0)
+             for point in record["validation"] if point["step"] <= stop]
+    steps, scores = [step for step, _ in curve], [score for _, score in curve]
+    trend, end = rule.trend(steps, scores), stopping.IMPROVING.trend(steps, scores, require_span=False)
+    return {"key": record["key"], "variant": row["model"], "size": row["train_size"], "seed": row["seed"],
+            "stopped_at": stop, "criterion_met": bool(row["converged"]), "too_short": trend is None,
+            "rule_stops": trend is not None and trend.gain_upper < rule.max_gain,
+            "improving": end is not None and end.gain_lower > 0.0,
+            "end_trend": None if end is None else dataclasses.asdict(end),
+            "trend": None if trend is None else dataclasses.asdict(trend),
+            "first_stop": rule.first_stop(steps, scores)}
+
+
+def audit(workdir: str | Path, rule: stopping.TrendRule = stopping.RULE) -> dict:
+    """The rows of every model recorded in `workdir` (a ``data_efficiency_full`` run) and their counts."""
+    rows = [audit_record(record, rule) for record in full_run.records(workdir).values()]
+    met = [row for row in rows if row["criterion_met"]]
+    counts = {
+        "models": len(rows), "criterion_met": len(met),
+        "stopped_while_improving": sum(row["improving"] for row in met),
+        "budget_ended_while_improving": sum(row["improving"] for row in rows if not row["criterion_met"]),
+        "rule_would_not_stop": sum(not row["rule_stops"] for row in met),
+        "rule_too_short": sum(row["too_short"] for row in met),
+        "rule_agrees": sum(row["rule_stops"] for row in met),
+    }
+    return {"rule": dataclasses.asdict(rule), "workdir": str(workdir), "counts": counts, "rows": rows}
+
+
+def markdown(results: Mapping) -> str:
+    """The audit as a markdown table, its counts first."""
+    counts, rule = results["counts"], results["rule"]
+    lines = [
+        "# The convergence criterion replayed under the trend rule",
+        "",
+        f"Of {counts['models']} models, the criterion ended {counts['criterion_met']} (the others ran to their "
+        f"budget). At the step it stopped them, {counts['stopped_while_improving']} were still improving (the "
+        f"trend of their last 10 000 steps falling, its one-sided 95% lower bound above 0), and so were "
+        f"{counts['budget_ended_while_improving']} of the {counts['models'] - counts['criterion_met']} that their "
+        f"budget ended; the trend rule (upper bound on the gain below {rule['max_gain']} points per {rule['per_steps']} "
+        f"steps) would have stopped {counts['rule_agrees']} of them there and kept training "
+        f"{counts['rule_would_not_stop']} ({counts['rule_too_short']} of them shorter than its window).",
+        "",
+        "Gains are score points (the mean of translation and rotation in % of zero) per 10 000 steps, positive when "
+        "the score falls: over the last 10 000 steps (improving: its lower bound above 0) and over the rule's window.",
+        "",
+        "| model | stopped at | criterion | gain, last 10 k steps | improving | gain, rule's window | its 95 % bounds "
+        "| rule stops there | rule's first stop |",
+        "|---|---:|---|---:|---|---:|---|---|---:|",
+    ]
+    for row in results["rows"]:
+        trend, end = row["trend"], row["end_trend"]
+        end_gain = "–" if end is None else f"{end['gain']:+.2f} ± {end['gain_se']:.2f}"
+        gain = "–" if trend is None else f"{trend['gain']:+.2f} ± {trend['gain_se']:.2f}"
+        bounds = "–" if trend is None else f"[{trend['gain_lower']:+.2f}, {trend['gain_upper']:+.2f}]"
+        stops = "window not spanned" if row["too_short"] else ("yes" if row["rule_stops"] else "no")
+        first = "–" if row["first_stop"] is None else f"{row['first_stop']:,}"
+        lines.append(f"| {row['key']} | {row['stopped_at']:,} | {'met' if row['criterion_met'] else 'budget'} | "
+                     f"{end_gain} | {'yes' if row['improving'] else 'no'} | {gain} | {bounds} | {stops} | {first} |")
+    return "\n".join(lines) + "\n"
+
+
+def write(results: Mapping, out_dir: str | Path) -> None:
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "results.json").write_text(json.dumps(full_run._compact(results), indent=1) + "\n")
+    (out_dir / "results.md").write_text(markdown(results))

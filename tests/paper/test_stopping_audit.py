@@ -1,0 +1,54 @@
+"""The audit of a convergence-criterion run under the trend rule, on records made here."""
+
+import json
+
+import numpy as np
+import pytest
+from absl import app
+
+from pushjax.paper import stopping_audit
+from tests.paper.conftest import run_binary
+
+
+def _record(key, scores, converged=True, decay=1_000):
+    steps = [1_000 * (index + 1) for index in range(len(scores))]
+    validation = [{"step": step, "trans_percent": score - 5.0, "rot_percent": score + 5.0}
+                  for step, score in zip(steps, scores)]
+    validation.append({"step": steps[-1] + decay, "trans_percent": 0.0, "rot_percent": 0.0})  # after the decay
+    variant, size, seed = key.rsplit("_", 2)
+    return {"key": key, "row": {"model": variant, "train_size": int(size), "seed": int(seed[len("seed"):]),
+                                "constant_steps": steps[-1], "converged": converged}, "validation": validation}
+
+
+def _write(folder, *records):
+    (folder / "models").mkdir(parents=True)
+    for record in records:
+        (folder / "models" / f"{record['key']}.json").write_text(json.dumps(record))
+
+
+def test_a_falling_curve_is_improving_and_a_flat_one_is_stopped(tmp_path):
+    rng = np.random.default_rng(0)
+    falling = 40.0 - 0.15 * np.arange(30) + rng.normal(0, 0.2, 30)  # 1.5 points per 10 000 steps
+    flat = 30.0 + rng.normal(0, 0.2, 30)
+    short = 40.0 - 0.5 * np.arange(8)
+    _write(tmp_path, _record("neural_100_seed0", falling), _record("hybrid_100_seed0", flat),
+           _record("error_100_seed0", short, converged=False))
+    results = stopping_audit.audit(tmp_path)
+    rows = {row["key"]: row for row in results["rows"]}
+    assert rows["neural_100_seed0"]["improving"] and not rows["neural_100_seed0"]["rule_stops"]
+    assert rows["neural_100_seed0"]["end_trend"]["gain"] == pytest.approx(1.5, abs=0.5)
+    assert not rows["hybrid_100_seed0"]["improving"] and rows["hybrid_100_seed0"]["rule_stops"]
+    assert rows["hybrid_100_seed0"]["first_stop"] is not None
+    assert rows["error_100_seed0"]["too_short"] and rows["error_100_seed0"]["improving"]
+    assert results["counts"] == {"models": 3, "criterion_met": 2, "stopped_while_improving": 1,
+                                 "budget_ended_while_improving": 1, "rule_would_not_stop": 1, "rule_too_short": 0,
+                                 "rule_agrees": 1}
+
+
+def test_the_binary_writes_the_audit_and_rejects_a_folder_without_records(tmp_path):
+    _write(tmp_path / "run", _record("neural_100_seed0", list(40.0 - 0.1 * np.arange(25))))
+    run_binary("stopping_audit", f"--workdir={tmp_path / 'run'}", f"--out_dir={tmp_path / 'out'}")
+    assert "| neural_100_seed0 | 25,000 | met |" in (tmp_path / "out" / "results.md").read_text()
+    assert json.loads((tmp_path / "out" / "results.json").read_text())["counts"]["models"] == 1
+    with pytest.raises(app.UsageError, match="--workdir: no model records in"):
+        run_binary("stopping_audit", f"--workdir={tmp_path / 'empty'}", f"--out_dir={tmp_path / 'out'}")
