@@ -47,8 +47,8 @@ def test_a_falling_curve_is_improving_and_a_flat_one_is_stopped(tmp_path):
 
 def test_the_binary_writes_the_audit_and_rejects_a_folder_without_records(tmp_path):
     _write(tmp_path / "run", _record("neural_100_seed0", list(40.0 - 0.1 * np.arange(25))))
-    run_binary("stopping_audit", f"--workdir={tmp_path / 'run'}", f"--out_dir={tmp_path / 'out'}")
+    run_binary("stopping_audit", f"--run={tmp_path / 'run'}", f"--workdir={tmp_path / 'out'}")
     assert "| neural_100_seed0 | 25,000 | met |" in (tmp_path / "out" / "results.md").read_text()
     assert json.loads((tmp_path / "out" / "results.json").read_text())["counts"]["models"] == 1
-    with pytest.raises(app.UsageError, match="--workdir: no model records in"):
-        run_binary("stopping_audit", f"--workdir={tmp_path / 'empty'}", f"--out_dir={tmp_path / 'out'}")
+    with pytest.raises(app.UsageError, match="--run: no model records in"):
+        run_binary("stopping_audit", f"--run={tmp_path / 'empty'}", f"--workdir={tmp_path / 'out'}")
