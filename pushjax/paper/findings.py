@@ -509,6 +509,20 @@ def load(workdirs: Sequence[str | os.PathLike]) -> dict[str, dict]:
     return results
 
 
+def side_by_side(before: Sequence[Finding], after: Sequence[Finding], labels: tuple[str, str]) -> str:
+    """Two decisions of the same findings (e.g. on models trained two ways) as one markdown table: each finding's
+    verdict under `labels[0]` and `labels[1]`, whether it changed, and the second's evidence."""
+    by_key = {finding.key: finding for finding in before}
+    lines = [f"| finding (the paper's) | experiment | {labels[0]} | {labels[1]} | changed | evidence ({labels[1]}) |",
+             "|---|---|---|---|---|---|"]
+    for finding in after:
+        old = by_key.get(finding.key)
+        verdict = old.verdict if old is not None else UNCHECKED
+        lines.append(f"| {finding.statement} | {finding.experiment} | {verdict} | {finding.verdict} | "
+                     f"{'yes' if verdict != finding.verdict else ''} | {finding.evidence} |")
+    return "\n".join(lines)
+
+
 def markdown(findings: Sequence[Finding]) -> str:
     """The findings as a markdown table."""
     lines = [f"Decided at {MARGIN:g} standard error of the difference ({CLEAR_MARGIN:g} for \"clearly\"); scores are "

@@ -423,6 +423,24 @@ def _in_threads(work: Callable[[], None], count: int) -> None:
         raise errors[0]
 
 
+def with_models_of(results: Mapping, workdir: str | Path) -> dict:
+    """`results` (a run's ``results.json``) with every trained cell (model, size) that the run in `workdir` recorded
+    replaced by that run's models, and the baselines replaced by that run's (its test split), e.g. Table 1 with its
+    models at the full split trained for the paper's 75 000 steps instead of to the criterion. Records which cells
+    came from where in ``replaced``."""
+    workdir = Path(workdir)
+    other = [record["row"] for record in records(workdir).values()]
+    cells = {(row["model"], row["train_size"]) for row in other}
+    baselines = json.loads((workdir / "baselines.json").read_text())
+    kept = [row for row in results["rows"]
+            if row["kind"] == "trained" and (row["model"], row["train_size"]) not in cells]
+    return {**results, "rows": baselines + kept + other,
+            "curves": [curve for curve in results.get("curves", [])
+                       if (curve["model"], curve["train_size"]) not in cells],
+            "replaced": {"workdir": str(workdir), "cells": sorted([model, size] for model, size in cells),
+                         "baselines": True}}
+
+
 def write_results(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit],
                   criterion: convergence.Criterion = convergence.CRITERION) -> dict:
     results = assemble(spec, workdir, units, criterion)

@@ -143,7 +143,7 @@ def test_a_recorded_model_loads_from_the_run_and_scores_as_recorded(smoke_result
         load_model(workdir, model="hybrid_99_seed0")
 
 
-def test_the_paper_schedule_trains_a_fixed_budget_and_continues_it(smoke_data, tmp_path):
+def test_the_paper_schedule_trains_a_fixed_budget_and_continues_it(smoke_data, smoke_results, tmp_path):
     workdir = tmp_path / "long"
     arguments = (*SMOKE, f"--data_dir={smoke_data('data_efficiency')}", f"--workdir={workdir}", "--sizes=80",
                  "--seeds=0", "--variants=neural", "--nowide", "--schedule=paper", "--criterion=eval_every=5")
@@ -159,5 +159,18 @@ def test_the_paper_schedule_trains_a_fixed_budget_and_continues_it(smoke_data, t
     continued = json.loads((workdir / "models" / "neural_80_seed0.json").read_text())
     assert continued["row"]["steps"] == 20 and continued["validation"][:2] == record["validation"]
     assert [point["step"] for point in continued["validation"]] == [5, 10, 15, 20]
+    # Its cell replaces the criterion's in Table 1, and the findings are decided both ways.
+    full = smoke_results("data_efficiency_full")
+    merged = full_run.with_models_of(json.loads((full / "results.json").read_text()), workdir)
+    neural_80 = [row for row in merged["rows"] if row["model"] == "neural" and row["train_size"] == 80]
+    assert [row["steps"] for row in neural_80] == [20] and merged["replaced"]["cells"] == [["neural", 80]]
+    assert sum(row["model"] == "hybrid" for row in merged["rows"]) == 2  # sizes 40 and 80, untouched
+    assert not any(curve["model"] == "neural" and curve["train_size"] == 80 for curve in merged["curves"])
+    output = tmp_path / "findings.md"
+    run_binary("findings", f"--workdirs={full}", f"--replace_with={workdir}", f"--output={output}")
+    table = output.read_text()
+    assert f"| as run | with {workdir} | changed |" in table and "neural" in table
+    with pytest.raises(app.UsageError, match="--replace_with: no model records in"):
+        run_binary("findings", f"--workdirs={full}", f"--replace_with={tmp_path / 'none'}")
     with pytest.raises(app.UsageError, match="--variants: simpel not trained by this run"):
         run_binary("data_efficiency_full", f"--workdir={tmp_path}", "--variants=simpel")
