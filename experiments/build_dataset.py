@@ -31,6 +31,7 @@ from absl import app, flags
 import experiments
 from pushjax.data import configs
 from pushjax.data.builder import IncompleteRawDirError, build
+from pushjax.mit.files import PushFileError
 
 _EXPERIMENT = flags.DEFINE_enum("experiment", "data_efficiency", [*configs.EXPERIMENTS, "all"], "Experiment.")
 _SCALE = flags.DEFINE_enum("scale", configs.DEFAULT_SCALE, list(configs.SCALES), "Scale.")
@@ -128,6 +129,8 @@ def main(argv):
                             testbed=_TESTBED.value, workers=_WORKERS.value, raw_dir=_RAW_DIR.value,
                             beam_runner=_BEAM_RUNNER.value, beam_options=beam_options,
                             min_test_sequences=_MIN_TEST_SEQUENCES.value)
+        except PushFileError:
+            raise  # names the file (`experiments.run` prints it as a usage error)
         except (IncompleteRawDirError, ValueError) as error:
             raise app.UsageError(f"--{error}") from None
         sizes = ", ".join(f"{name} {split.num_examples}" for name, split in builder.info.splits.items())

@@ -84,7 +84,7 @@ def main(argv):
         raise app.UsageError(f"unexpected arguments: {argv[1:]}")
     workdir = cli.WORKDIR.value
     if workdir is None:
-        raise app.UsageError("--workdir is required")
+        raise app.UsageError("--workdir: expected a value (the flag is required)")
     try:
         paths.check_writable_folder(workdir)
     except ValueError as error:

@@ -1,8 +1,9 @@
 """Every flag of every binary under ``experiments/`` rejects a bad value with one line naming the flag.
 
-Each case runs ``python -m experiments.<binary> <flags>`` in a process of its own, which must exit non-zero,
-print no traceback and name the flag in the last line of stderr, before any dataset is built or model trained
-(a run that goes on is killed after `CASE_TIMEOUT_S`). Starting Python and importing JAX, TFDS and MuJoCo takes
+Each case runs ``python -m experiments.<binary> <flags>`` in a process of its own, which must exit with status 2
+and print ``error: <flag>: <what was expected>`` as the last line of stderr, with no traceback, no flag help and at
+most three lines besides absl's log lines, before any dataset is built or model trained (a run that goes on is
+killed after `CASE_TIMEOUT_S`). Starting Python and importing JAX, TFDS and MuJoCo takes
 seconds, so one server process imports the binaries' libraries once and forks a child per case, which runs the
 binary as ``python -m`` does (``runpy`` as ``__main__``, with ``sys.argv`` set) and reports how it ended as the
 interpreter does, then skips the interpreter's seconds-long teardown of those libraries.
@@ -10,6 +11,7 @@ interpreter does, then skips the interpreter's seconds-long teardown of those li
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -17,6 +19,11 @@ from pathlib import Path
 REPOSITORY = Path(__file__).resolve().parents[1]
 CASE_TIMEOUT_S = 60
 PARALLEL = 3
+USAGE_ERROR_STATUS = 2  # experiments.USAGE_ERROR_STATUS
+LOG_LINE = re.compile(r"^[IWEF]\d{4} \d\d:\d\d:\d\d\.\d+ ")
+"""An absl log line (``I1128 14:52:43.523777 140361020308352 file.py:849] ...``)."""
+HELP_TEXT = re.compile(r"^\s+--\[?\w|^flags:|^\s+\(default: |Try --help")
+"""A line of absl's flag help."""
 
 LIBRARIES = ("experiments, pushjax.data, pushjax.loop, pushjax.paper.findings, pushjax.paper.figures, "
              "pushjax.paper.rollouts, pushjax.paper.runner, pushjax.paper.spec, pushjax.paper.tables, "
@@ -131,12 +138,24 @@ CASES = [
     ("data_efficiency", [*RUN, "extra"], "unexpected arguments"),
     ("data_efficiency", [*RUN, "--config.schedule=bogus"], "--config.schedule"),
     ("data_efficiency", [*RUN, "--config.bogus=1"], "config.bogus"),
+    ("data_efficiency", [*RUN, "--sizes=-200"], "--sizes"),
+    ("data_efficiency", [*RUN, "--variants=hybrd"], "--variants"),
+    ("data_efficiency", [*RUN, "--bogus=1"], "--bogus"),
+    ("data_efficiency", [*RUN, "--nobuild=x"], "--nobuild"),
+    ("data_efficiency", [*RUN, "--scale"], "--scale"),
+    *[("data_efficiency", [*RUN, f"--config.{field}={value}"], f"--config.{field}")
+      for field, value in (("learning_rate", "abc"), ("learning_rate", "-1"), ("learning_rate", "nan"),
+                           ("weight_decay", "-1"), ("batch_size", "1.5"), ("model.head_features", "64,,32"),
+                           ("model.head_features", "64,"), ("model.head_features", ""),
+                           ("model.head_features", "0,8"), ("model.glimpse_kernel", "0"),
+                           ("model.batch_norm_momentum", "2"))],
     # Each other experiment binary: the shared flags are wired, and its datasets are looked for.
     *[(binary, [*RUN], "--build") for binary in EXPERIMENTS[1:]],
     *[(binary, [*RUN, "--workdir={file}/work"], "--workdir") for binary in EXPERIMENTS[1:]],
     *[(binary, [*RUN, "--sizes=0"], "--sizes") for binary in EXPERIMENTS[1:]],
     # rollouts: its own flag and the variants it can roll out.
     ("rollouts", [*RUN, "--test_splits=test_7"], "--test_splits"),
+    ("rollouts", [*RUN, "--test_splits=test_999"], "--test_splits"),
     ("rollouts", [*RUN, "--test_splits=test_20,test_20"], "--test_splits"),
     ("rollouts", [*RUN, "--variants=simple"], "--variants"),
     # train: the shared flags and its own.
@@ -231,6 +250,8 @@ CASES = [
       for value in values],
     ("track", ["--workdir={tmp}/track", "--learn_steps=5", "--filters=ekf,ukf"], "--learn_steps"),
     ("track", ["--workdir={tmp}/track", "extra"], "unexpected arguments"),
+    ("track", ["--workdir={tmp}/track", "--perception={tmp}/missing"], "--perception"),
+    ("track", ["--workdir={tmp}/track", "--perception={empty}"], "--perception"),
     # push_to_goal
     ("push_to_goal", [], "--workdir"),
     ("push_to_goal", ["--workdir={file}/goals"], "--workdir"),
@@ -248,6 +269,9 @@ CASES = [
     ("push_to_goal", ["--workdir={tmp}/goals", "--models=lynch,loop"], "--loop_model"),
     ("push_to_goal", ["--workdir={tmp}/goals", "--loop_model={file}"], "--loop_model"),
     ("push_to_goal", ["--workdir={tmp}/goals", "--models=loop", "--loop_model={tmp}/missing.json"], "--loop_model"),
+    ("push_to_goal", ["--workdir={tmp}/goals", "--models=loop", "--loop_model={file}"], "--loop_model"),
+    ("push_to_goal", ["--workdir={tmp}/goals", "--states=perception", "--perception={tmp}/missing"], "--perception"),
+    ("push_to_goal", ["--workdir={tmp}/goals", "--states=perception"], "--perception"),
     # demo
     *[("demo", [f"--{flag}={value}"], f"--{flag}")
       for flag, values in (("mu", ("-1", "nan", "inf")), ("angle_deg", ("90", "-120", "nan")),
@@ -294,9 +318,13 @@ def test_every_bad_flag_is_a_one_line_usage_error(tmp_path):
     failures = []
     for index, ((binary, arguments), (_, _, flag), exit_code) in enumerate(zip(cases, CASES, exit_codes)):
         stderr = (out / f"{index}.stderr").read_text()
-        lines = [line for line in stderr.splitlines() if line.strip()]
+        lines = [line for line in stderr.splitlines() if line.strip() and not LOG_LINE.match(line)]
         last = lines[-1] if lines else ""
-        if exit_code == 0 or "Traceback" in stderr or flag not in last:
-            failures.append(f"python -m experiments.{binary} {' '.join(arguments)}: exit {exit_code}, "
-                            f"last line {last!r}" + (" (traceback)" if "Traceback" in stderr else ""))
+        problems = [problem for problem, found in (
+            (f"exit {exit_code}", exit_code != USAGE_ERROR_STATUS), ("traceback", "Traceback" in stderr),
+            ("flag help", any(HELP_TEXT.search(line) for line in lines)), (f"{len(lines)} lines", len(lines) > 3),
+            ("no 'error: ' line naming the flag", not (last.startswith("error: ") and flag in last))) if found]
+        if problems:
+            failures.append(f"python -m experiments.{binary} {' '.join(arguments)}: {', '.join(problems)}; "
+                            f"last line {last!r}")
     assert not failures, f"{len(failures)} of {len(CASES)} cases:\n" + "\n".join(failures)

@@ -77,6 +77,11 @@ class IncompleteRawDirError(ValueError):
     """A user's ``raw_dir`` that lacks files the config plans; the message counts them and names the first."""
 
 
+class DatasetFolderError(ValueError):
+    """A dataset folder that TFDS cannot read: its ``dataset_info.json`` is damaged or was written by another version
+    of the dataset; the message (``data_dir: <folder> ...``) names the folder and what is wrong."""
+
+
 @dataclasses.dataclass(eq=False)
 class PushEffectsConfig(tfds.core.BuilderConfig):
     """A TFDS builder config carrying the :class:`pushjax.data.configs.DatasetConfig` it builds."""
@@ -142,7 +147,16 @@ class PushEffects(tfds.core.GeneratorBasedBuilder):
             kwargs["config"] = _builder_config(dataclasses.replace(base.dataset, seed=seed,
                                                                    min_test_sequences=min_test_sequences))
         kwargs.setdefault("file_format", "array_record")
-        super().__init__(**kwargs)
+        try:
+            super().__init__(**kwargs)
+        except Exception as error:  # TFDS reports a bad dataset_info.json in many ways
+            folder = getattr(self, "_data_dir", None)
+            if folder is None:  # failed before it looked at the folder: not a folder's fault
+                raise
+            detail = " ".join(f"{type(error).__name__}: {error}".split())
+            raise DatasetFolderError(
+                f"data_dir: {folder} is not a readable {DATASET_NAME} {self.VERSION} dataset ({detail}); delete the "
+                "folder to build the dataset again") from error
         self._raw_dir = Path(raw_dir) if raw_dir is not None else (
             Path(self.data_dir).parents[2] / RAW_DIR_NAME / self.builder_config.dataset.testbed / f"seed{seed}")
         self._simulate_missing = raw_dir is None

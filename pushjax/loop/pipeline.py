@@ -230,15 +230,15 @@ def close_loop(
         try:
             examples, build = build_examples(loading, horizon=settings.horizon, stride=settings.stride,
                                              pusher_friction=settings.pusher_friction)
-        except ValueError as error:
-            raise ValueError(f"data_dir: {error}") from None
+        except ValueError as error:  # the files skipped, if any, may be why
+            raise ValueError(f"data_dir: {error}" + (f"; {pushes.summary()}" if pushes.n_skipped else "")) from None
         n_skipped = pushes.n_skipped + build.n_skipped
         stages.update()
 
         try:
             decision = decide(examples, settings, seed, stage)
         except ValueError as error:
-            raise ValueError(f"data_dir: {error}") from None
+            raise ValueError(f"data_dir: {error}" + (f"; {pushes.summary()}" if pushes.n_skipped else "")) from None
         stages.update()
 
         stage("refitting on the pool and measuring on the test split")

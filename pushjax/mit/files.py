@@ -65,12 +65,18 @@ class PushFileError(ValueError):
     Attributes:
       path: the offending file.
       reason: a short category (e.g. ``"unreadable file"``, ``"missing dataset"``) used to count skipped files.
+      detail: what is wrong, naming the field (e.g. ``"object_pose holds NaN or infinite values"``).
     """
 
     def __init__(self, path: str | os.PathLike, reason: str, detail: str):
-        super().__init__(f"{os.fspath(path)}: {reason}: {detail}")
+        super().__init__(f"{os.fspath(path)}: {reason}: {' '.join(str(detail).split())}")
         self.path = Path(path)
         self.reason = reason
+        self.detail = detail
+
+    def __reduce__(self):
+        # Pickled with its own arguments, so that it crosses from a worker process (a dataset build) intact.
+        return type(self), (self.path, self.reason, self.detail)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -550,10 +556,12 @@ class PushIterator:
             else:
                 self.n_filtered += 1
         self._unloadable: dict[str, list[Path]] = {}
+        self._first_unloadable: PushFileError | None = None
         self.n_yielded = 0
 
     def __iter__(self) -> Iterator[Push]:
         self._unloadable = collections.defaultdict(list)
+        self._first_unloadable = None
         self.n_yielded = 0
         try:
             for path in self.paths:
@@ -561,6 +569,7 @@ class PushIterator:
                     push = load_push(path, frequency=self.frequency, zero_initial_pose=self.zero_initial_pose)
                 except PushFileError as error:
                     self._unloadable[error.reason].append(path)
+                    self._first_unloadable = self._first_unloadable or error
                     continue
                 self.n_yielded += 1
                 yield push
@@ -580,11 +589,13 @@ class PushIterator:
         return sum(len(paths) for paths in self.skipped.values())
 
     def summary(self) -> str:
-        """One line: pushes yielded, files filtered out, files skipped (count per reason)."""
+        """One line: pushes yielded, files filtered out, files skipped (count per reason), and the first file that
+        failed to load, with what is wrong in it."""
         reasons = ", ".join(f"{reason}: {len(paths)}" for reason, paths in self.skipped.items())
+        first = f"; the first that failed to load: {self._first_unloadable}" if self._first_unloadable else ""
         return (
             f"MIT push files under {str(self.root)!r}: {self.n_yielded} pushes yielded, "
-            f"{self.n_filtered} filtered out, {self.n_skipped} skipped" + (f" ({reasons})" if reasons else "")
+            f"{self.n_filtered} filtered out, {self.n_skipped} skipped" + (f" ({reasons})" if reasons else "") + first
         )
 
 

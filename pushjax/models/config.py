@@ -69,6 +69,15 @@ class ModelConfig:
             )
         if self.glimpse_size <= 0:
             raise ValueError(f"glimpse_size: expected a positive size in pixels, got {self.glimpse_size}")
+        for name in ("glimpse_kernel", "locator_kernel"):
+            if getattr(self, name) <= 0:
+                raise ValueError(f"{name}: expected a positive kernel side in pixels, got {getattr(self, name)}")
+        for name in ("glimpse_features", "locator_conv_features", "locator_deconv_features", "head_features",
+                     "error_features"):
+            if any(width <= 0 for width in getattr(self, name)):
+                raise ValueError(f"{name}: expected positive layer widths, got {getattr(self, name)}")
+        if not 0 <= self.batch_norm_momentum <= 1:
+            raise ValueError(f"batch_norm_momentum: expected a decay in [0, 1], got {self.batch_norm_momentum}")
         if self.length_scale_m <= 0 or self.rotation_scale_rad <= 0:
             raise ValueError("length_scale_m, rotation_scale_rad: expected positive scales")
 

@@ -17,7 +17,7 @@ from absl import app, flags, logging
 from pushjax.data import configs as data_configs
 from pushjax.paper import figures, paths, reference, runner, spec as spec_lib, tables, visualize
 from pushjax.sim import testbed
-from pushjax.train import SWEEP_MODES, distributed
+from pushjax.train import SWEEP_MODES, distributed, sweep_trainer
 from pushjax.train import configs as train_configs
 
 SCALE = flags.DEFINE_enum("scale", data_configs.DEFAULT_SCALE, data_configs.SCALES, "Dataset and training scale.")
@@ -39,9 +39,10 @@ COORDINATOR_ADDRESS = flags.DEFINE_string(
 NUM_PROCESSES = flags.DEFINE_integer("num_processes", 1, "Processes (one per host) that train together.")
 PROCESS_ID = flags.DEFINE_integer("process_id", 0, "This process's index in [0, --num_processes).")
 CONFIG_OVERRIDES = {
-    path: flags.DEFINE_string(f"config.{path}", None, f"Replace the training config's {path} "
-                              f"({field_type.__name__ if field_type in (int, float, str) else 'comma-separated integers'}; default: the "
-                              "scale's).")
+    path: flags.DEFINE_string(
+        f"config.{path}", None, f"Replace the training config's {path} ("
+        f"{field_type.__name__ if field_type in (int, float, str) else 'comma-separated integers > 0'}; default: the "
+        "scale's).")
     for path, field_type in train_configs.OVERRIDABLE_FIELDS.items()
 }
 """``--config.<field>=<value>`` (Flax / big_vision style): any training-config field, recorded in results.json."""
@@ -54,7 +55,7 @@ def spec_from_flags(setup: spec_lib.Setup) -> spec_lib.ExperimentSpec:
     anything touches JAX.
     """
     if WORKDIR.value is None:
-        raise app.UsageError("--workdir is required")
+        raise app.UsageError("--workdir: expected a value (the flag is required)")
     try:
         paths.check_writable_folder(WORKDIR.value)
     except ValueError as error:
@@ -78,14 +79,15 @@ def spec_from_flags(setup: spec_lib.Setup) -> spec_lib.ExperimentSpec:
 def run_spec(spec: spec_lib.ExperimentSpec) -> runner.RunOutcome:
     """`runner.run` of `spec` in ``--workdir``, its warnings (e.g. clipped sizes) logged once each.
 
-    A dataset the flags do not let the run build (`runner.DatasetUnavailableError`, which names the flag) is an
-    ``app.UsageError``.
+    A dataset the flags do not let the run build (`runner.DatasetUnavailableError`, which names the flag) and a work
+    directory holding other models' checkpoints (`pushjax.train.sweep_trainer.WorkdirConflictError`) are
+    ``app.UsageError``s.
     """
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             outcome = runner.run(spec, WORKDIR.value)
-        except runner.DatasetUnavailableError as error:
+        except (runner.DatasetUnavailableError, sweep_trainer.WorkdirConflictError) as error:
             raise app.UsageError(f"--{error}") from error
     for message in dict.fromkeys(str(warning.message) for warning in caught):
         logging.warning("%s", message)

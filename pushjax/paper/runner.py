@@ -89,24 +89,43 @@ def clip_sizes(sizes: Sequence[int], count: int, split: str = "train") -> tuple[
 
 
 class DatasetUnavailableError(ValueError):
-    """A dataset the run needs is not built and the run's settings do not let it be built; names the setting."""
+    """A dataset the run needs is not built and the run's settings do not let it be built, or its folder cannot be
+    read (`pushjax.data.builder.DatasetFolderError`); names the setting."""
+
+
+def _other_versions(folder: Path) -> str:
+    """``; found version 2.0.0 beside it, ...`` when `folder`'s parent holds datasets of other versions, else ``""``."""
+    parent = folder.parent
+    versions = sorted(child.name for child in parent.iterdir() if child != folder and
+                      (child / "dataset_info.json").is_file()) if parent.is_dir() else []
+    if not versions:
+        return ""
+    return (f"; found version{'s' * (len(versions) > 1)} {', '.join(versions)} beside it, which this pushjax does not "
+            f"read")
 
 
 def load_splits(spec: ExperimentSpec, dataset: data.DatasetConfig, progress: bool = True):
     """split name -> random-access source of `dataset`, built first when the spec allows it and it is missing.
 
     Logs which dataset (name, version, folder) it reused or built (`pushjax.data.build`). Raises
-    `DatasetUnavailableError` before building anything when `dataset` is missing and ``spec.build`` is off, or when
-    it is missing and its data directory is not writable.
+    `DatasetUnavailableError` before building anything when `dataset` is missing and ``spec.build`` is off (naming
+    the versions of it found beside the one this pushjax reads), when it is missing and its data directory is not
+    writable, or when its folder holds a dataset TFDS cannot read (a damaged ``dataset_info.json``, or one of
+    another version).
     """
     identity = dict(seed=dataset.seed, testbed=dataset.testbed, min_test_sequences=dataset.min_test_sequences)
-    builder = data.PushEffects(config=data.config_name(dataset.experiment, dataset.scale, dataset.testbed),
-                               data_dir=spec.data_dir, seed=dataset.seed, min_test_sequences=dataset.min_test_sequences)
+    try:
+        builder = data.PushEffects(config=data.config_name(dataset.experiment, dataset.scale, dataset.testbed),
+                                   data_dir=spec.data_dir, seed=dataset.seed,
+                                   min_test_sequences=dataset.min_test_sequences)
+    except data.builder.DatasetFolderError as error:
+        raise DatasetUnavailableError(str(error)) from None
     if not builder.is_prepared():
         name = data.dataset_name(dataset.experiment, dataset.scale, **identity)
         if not spec.build:
-            raise DatasetUnavailableError(f"build: dataset {name} is not built (looked in {builder.data_dir}) and --nobuild "
-                             "forbids building it; --build builds it there")
+            raise DatasetUnavailableError(f"build: dataset {name} is not built (looked in {builder.data_dir}"
+                                          f"{_other_versions(Path(builder.data_dir))}) and --nobuild forbids building "
+                                          "it; --build builds it there")
         try:
             paths.check_writable_folder(builder.data_dir_root)
         except ValueError as error:

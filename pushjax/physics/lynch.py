@@ -34,7 +34,8 @@ Conventions shared by all functions:
   The remaining ``v_pb . normal <= 0`` guard (``v_p = 0``) only keeps invalid input (``l = 0``)
   finite.
 * Requires ``l > 0`` and ``mu >= 0``. The jitted functions never branch on values; call
-  :func:`check_inputs` on concrete arrays (outside ``jax.jit``) to validate user input. They do check
+  :func:`check_inputs` on concrete arrays (outside ``jax.jit``) to validate user input (which also
+  requires unit normals, so that a zero normal does not pass for a push). They do check
   shapes and dtypes (real numbers, points with a trailing axis of 2, batch shapes that broadcast) when
   traced, which is static information: a ``ValueError`` names the argument, under ``jax.jit``,
   ``jax.vmap`` and ``jax.grad`` alike, at no run-time cost.
@@ -53,6 +54,9 @@ import numpy as np
 
 __all__ = ["check_inputs", "effective_push_velocity", "object_velocity", "predict", "with_push_gate_gradient"]
 
+
+NORMAL_LENGTH_TOLERANCE = 1e-3
+"""How far from 1 the length of a normal given to :func:`check_inputs` may be."""
 
 _VECTOR_SIZES = {"contact": 2, "normal": 2, "action": 2, "v_p": 2, "motion": 3}
 """The arguments that are vectors in the last axis, and their sizes; all others are one number per push."""
@@ -413,10 +417,14 @@ def check_inputs(contact, normal, action, l, mu, s=1.0) -> None:
     tracers); the jitted model functions themselves never check values. Argument meanings and
     shapes as in :func:`predict`.
 
+    The jitted functions take a normal of any length (and a zero normal as "no contact"); a user's
+    input must hold unit normals (length 1 within `NORMAL_LENGTH_TOLERANCE`), so that a zero
+    normal, which silently predicts no motion, or an unnormalised one is caught here.
+
     Raises:
       ValueError: if ``contact``, ``normal`` or ``action`` does not have a trailing axis of size 2,
-        the batch shapes do not broadcast, any value is NaN or infinite, ``l <= 0``, ``mu < 0`` or
-        ``s`` lies outside [0, 1].
+        the batch shapes do not broadcast, any value is NaN or infinite, a normal is not a unit
+        vector, ``l <= 0``, ``mu < 0`` or ``s`` lies outside [0, 1].
     """
     arrays = {
         name: np.asarray(value)
@@ -426,6 +434,12 @@ def check_inputs(contact, normal, action, l, mu, s=1.0) -> None:
     for name, value in arrays.items():
         if not np.all(np.isfinite(value)):
             raise ValueError(f"{name}: expected finite values, got NaN or infinity")
+    lengths = np.linalg.norm(arrays["normal"], axis=-1)
+    off = lengths[np.abs(lengths - 1) > NORMAL_LENGTH_TOLERANCE]
+    if off.size:
+        zero = " (a zero normal predicts no motion)" if off[0] == 0 else ""
+        raise ValueError(f"normal: expected unit vectors (length 1 within {NORMAL_LENGTH_TOLERANCE:g}), got length "
+                         f"{off[0]:.6g}{zero}")
     if np.any(arrays["l"] <= 0):
         raise ValueError("l: expected limit-surface ratio > 0")
     if np.any(arrays["mu"] < 0):

@@ -182,6 +182,12 @@ def save_model(folder: str | os.PathLike, step: int, model_config: ModelConfig, 
         checkpointer.close()
 
 
+def _one_line(error: BaseException, limit: int = 300) -> str:
+    """``<type>: <message>`` of `error` on one line, without tensorstore's spec dump, at most `limit` characters."""
+    text = " ".join(f"{type(error).__name__}: {error}".split(" [tensorstore_spec=")[0].split())
+    return text if len(text) <= limit else text[:limit - 1] + "…"
+
+
 def model_config_from_json(config: Mapping) -> ModelConfig:
     """The `ModelConfig` of ``dataclasses.asdict(config)`` read back from JSON (lists become tuples)."""
     fields = {field.name for field in dataclasses.fields(ModelConfig)}
@@ -222,9 +228,16 @@ def load_model(path: str | os.PathLike, model: int | str = 0, step: int | None =
         step = max(steps) if step is None else step
         if step not in steps:
             raise ValueError(f"step: {folder} has checkpoints at steps {sorted(steps)}, not {step}")
-        state, metadata = checkpointer.restore_arrays(step)
+        try:
+            state, metadata = checkpointer.restore_arrays(step)
+        except Exception as error:  # orbax and tensorstore report a damaged file in many ways
+            raise ValueError(f"path: the checkpoint {folder / str(step)} cannot be read, a file in it is damaged or "
+                             f"missing ({_one_line(error)}); train the model again or restore the folder") from error
     finally:
         checkpointer.close()
+    if not isinstance(metadata, Mapping) or not isinstance(state, Mapping) or "params" not in state:
+        raise ValueError(f"path: the checkpoint {folder / str(step)} holds no model: expected parameters ('params') "
+                         "and a metadata dictionary")
     missing = [key for key in (MODEL_CONFIG_KEY, MODEL_VARIANTS_KEY, "identity") if key not in metadata]
     if missing:
         raise ValueError(f"path: the checkpoint {folder / str(step)} has no {', '.join(missing)} in its metadata (it "

@@ -146,6 +146,10 @@ def _compiled_step(
     return jax.jit(unrolled_step if mesh is None else mesh_lib.map_models(unrolled_step, mesh))
 
 
+class WorkdirConflictError(ValueError):
+    """A sweep's work directory that holds a checkpoint of other models; the message (``workdir: ...``) names it."""
+
+
 class _SequentialStepper:
     """``sequential``: the jitted single-model step once per model, the K states kept apart."""
 
@@ -341,7 +345,7 @@ def sweep(
         if metadata is not None:
             if metadata.get("identity") != identity:
                 checkpointer.close()
-                raise ValueError(
+                raise WorkdirConflictError(
                     f"workdir: {workdir} holds a checkpoint of different models "
                     f"({metadata.get('identity')}); use a fresh work directory"
                 )

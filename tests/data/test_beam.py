@@ -71,20 +71,24 @@ def test_cli_builds_with_beam_worker_processes(tmp_path):
     _assert_same_files(tmp_path / "pool" / "push_effects_raw", tmp_path / "beam" / "push_effects_raw", "*.h5")
 
 
-# Parses each case's flags with the binary's own flags, as `experiments.run` does; prints the one-line errors.
+# Parses each case's flags with the binary's own flags, as `experiments.run` does; prints the one-line errors (the
+# last line it wrote on stderr before exiting with status 2).
 _PARSE = """
-import json, sys
+import contextlib, io, json, sys
 from absl import flags
 import experiments
 import experiments.build_dataset
 errors = []
 for arguments in json.loads(sys.argv[1]):
     flags.FLAGS.unparse_flags()
+    stderr = io.StringIO()
     try:
-        experiments.parse_flags_or_exit(["build_dataset", *arguments])
+        with contextlib.redirect_stderr(stderr):
+            experiments.parse_flags_or_exit(["build_dataset", *arguments])
         errors.append(None)
     except SystemExit as error:
-        errors.append(str(error.code))
+        assert error.code == experiments.USAGE_ERROR_STATUS, error.code
+        errors.append(stderr.getvalue().splitlines()[-1])  # after absl's log lines, if any
 print(json.dumps(errors))
 """
 
@@ -110,4 +114,5 @@ def test_bad_beam_flags_are_one_line_errors(tmp_path):
         if flag is None:
             assert error is None, (arguments, error)
         else:
-            assert error is not None and "\n" not in error and flag in error, (arguments, error)
+            assert error is not None and "\n" not in error and error.startswith("error: ") and flag in error, \
+                (arguments, error)

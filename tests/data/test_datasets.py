@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from pushjax.data import configs
-from pushjax.data.builder import IncompleteRawDirError, PushEffects, build, load
+from pushjax.data.builder import DatasetFolderError, IncompleteRawDirError, PushEffects, build, load
 from pushjax.data.examples import ALL_FIELDS
 from pushjax.data.schema import FIELDS
 from pushjax.geometry import OBJECT_NAMES, THICKNESS
@@ -257,6 +257,40 @@ def test_cli_refuses_an_incomplete_raw_dir(tmp_path):
     assert result.returncode != 0 and "Traceback" not in result.stderr, result.stderr[-3000:]
     assert "--raw_dir: 1 of 1 files" in result.stderr
     assert not list(raw_dir.iterdir())
+
+
+@pytest.mark.parametrize("dataset_info, detail", [
+    ('{"name": "push_effects", "version": "2.0.0"}', r"AssertionError: .*Builder version: 3\.0\.0\. Proto version: "
+                                                     r"2\.0\.0"),
+    ("not json", "ParseError: Failed to load JSON"),
+])
+def test_a_dataset_folder_of_another_version_or_damaged_is_named(tmp_path, dataset_info, detail):
+    folder = tmp_path / "push_effects" / "data_efficiency_smoke" / str(PushEffects.VERSION)
+    folder.mkdir(parents=True)
+    (folder / "dataset_info.json").write_text(dataset_info)
+    with pytest.raises(DatasetFolderError, match=f"^data_dir: {folder} is not a readable push_effects "
+                                                 rf"{PushEffects.VERSION} dataset \({detail}.*\); delete the folder to "
+                                                 "build the dataset again$") as error:
+        PushEffects(config="data_efficiency_smoke", data_dir=tmp_path)
+    assert "\n" not in str(error.value)
+    with pytest.raises(ValueError, match="BuilderConfig bogus_smoke not found") as error:  # not the folder's fault
+        PushEffects(config="bogus_smoke", data_dir=tmp_path)
+    assert not isinstance(error.value, DatasetFolderError)
+
+
+def test_cli_names_a_damaged_raw_file(tmp_path):
+    """A push file of a given raw folder that is not HDF5: one line naming it, also from a worker process."""
+    raw_dir = tmp_path / "real_mit_files"
+    planned = configs.plan_splits(configs.get_config("repeated", "smoke"), raw_dir).jobs[0].path
+    planned.parent.mkdir(parents=True)
+    planned.write_text("not HDF5")
+    result = subprocess.run(
+        [sys.executable, "-m", "experiments.build_dataset", "--experiment=repeated", "--scale=smoke",
+         f"--data_dir={tmp_path / 'data'}", "--workers=2", f"--raw_dir={raw_dir}"],
+        capture_output=True, text=True, cwd=Path(__file__).resolve().parents[2])
+    assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr[-3000:]
+    assert result.stderr.splitlines()[-1].startswith(f"error: {planned}: unreadable file: corrupt or truncated HDF5 "
+                                                     "file ("), result.stderr[-3000:]
 
 
 def test_seeded_configs_testbeds_and_bad_names():

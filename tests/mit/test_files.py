@@ -5,6 +5,7 @@ import json
 import logging
 import math
 import multiprocessing
+import pickle
 import time
 from pathlib import Path
 
@@ -235,6 +236,36 @@ def test_nan_and_single_time_stamp_files_raise(tmp_path):
         files.load_push(write_file(tmp_path / "t.h5", tip_pose=tip, object_pose=obj, ft_wrench=constant_time))
 
 
+@pytest.mark.parametrize("change, reason, message", [
+    (dict(object_pose=lambda pose: np.where(np.arange(len(pose))[:, None] == 3, np.nan, pose)), "non-finite values",
+     "object_pose holds NaN or infinite values"),
+    (dict(tip_pose=lambda pose: pose[:, :3]), "wrong shape", r"tip_pose must have shape \[N, 4\], got \(26, 3\)"),
+    (dict(ft_wrench=lambda pose: pose[None]), "wrong shape", r"ft_wrench must have shape \[N, 4\], got \(1, 26, 4\)"),
+])
+def test_a_bad_pose_is_one_line_naming_the_file_and_the_field(tmp_path, change, reason, message):
+    streams = dict(zip(("tip_pose", "object_pose", "ft_wrench"), linear_push()))
+    streams.update({name: damage(streams[name]) for name, damage in change.items()})
+    path = write_file(tmp_path / "bad.h5", **streams)
+    for read in (files.read_raw_push, files.load_push):
+        with pytest.raises(PushFileError, match=f"^{path}: {reason}: {message}$") as error:
+            read(path)
+        assert "\n" not in str(error.value) and error.value.path == path
+
+
+def test_push_file_errors_cross_process_boundaries(tmp_path):
+    """A worker's PushFileError (a dataset build's process pool) reaches the parent whole, not as a broken pool."""
+    error = PushFileError(tmp_path / "x.h5", "unreadable file", "corrupt or truncated HDF5 file (eof)")
+    copy = pickle.loads(pickle.dumps(error))
+    assert (type(copy), str(copy), copy.path, copy.reason, copy.detail) == (
+        PushFileError, str(error), error.path, error.reason, error.detail)
+    truncated = files.write_push(files.push_file_path(tmp_path, PARAMS), PARAMS, *linear_push(n=500))
+    truncated.write_bytes(truncated.read_bytes()[:300])
+    with concurrent.futures.ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as pool:
+        with pytest.raises(PushFileError, match=f"^{truncated}: unreadable file: corrupt or truncated") as raised:
+            pool.submit(files.load_push, truncated).result()
+    assert raised.value.reason == "unreadable file" and raised.value.path == truncated
+
+
 def test_missing_file_is_not_a_data_error(tmp_path):
     with pytest.raises(FileNotFoundError):
         files.read_raw_push(tmp_path / "absent.h5")
@@ -347,7 +378,8 @@ def test_iter_pushes_yields_sorted_and_reports_skipped(dataset_root, caplog):
     }
     assert pushes.n_skipped == 3 and pushes.n_filtered == 0
     assert "5 pushes yielded, 0 filtered out, 3 skipped (missing dataset: 1, unparseable file name: 1, " \
-           "unreadable file: 1)" in caplog.text
+           "unreadable file: 1); the first that failed to load: " \
+           f"{dataset_root}/abs/rect1/{CANONICAL_NAME}: unreadable file: corrupt or truncated" in caplog.text
     # A second pass yields the same pushes and the same report.
     assert [push.path for push in pushes] == [push.path for push in loaded] and pushes.n_skipped == 3
 

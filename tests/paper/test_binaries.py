@@ -113,6 +113,41 @@ def test_nobuild_names_the_missing_dataset_where_it_looked_and_build(tmp_path, b
     assert not (tmp_path / "push_effects").exists()
 
 
+def test_nobuild_names_the_other_versions_it_found(tmp_path):
+    (tmp_path / "push_effects" / "data_efficiency_smoke" / "2.0.0").mkdir(parents=True)
+    (tmp_path / "push_effects" / "data_efficiency_smoke" / "2.0.0" / "dataset_info.json").write_text("{}")
+    message = (r"^--build: dataset push_effects/data_efficiency_smoke is not built \(looked in "
+               f"{tmp_path}/push_effects/data_efficiency_smoke/3.0.0; found version 2.0.0 beside it, which this "
+               r"pushjax does not read\) and --nobuild forbids building it; --build builds it there$")
+    with pytest.raises(app.UsageError, match=message):
+        run_binary("data_efficiency", "--scale=smoke", f"--workdir={tmp_path / 'work'}", f"--data_dir={tmp_path}",
+                   "--nobuild")
+
+
+@pytest.mark.parametrize("build", ["--build", "--nobuild"])
+def test_a_dataset_folder_of_another_version_is_a_usage_error(tmp_path, build):
+    folder = tmp_path / "push_effects" / "data_efficiency_smoke" / "3.0.0"
+    folder.mkdir(parents=True)
+    (folder / "dataset_info.json").write_text('{"name": "push_effects", "version": "2.0.0"}')
+    with pytest.raises(app.UsageError, match=f"^--data_dir: {folder} is not a readable push_effects 3.0.0 dataset "
+                                             r"\(AssertionError: .*Proto version: 2.0.0\); delete the folder"):
+        run_binary("data_efficiency", "--scale=smoke", f"--workdir={tmp_path / 'work'}", f"--data_dir={tmp_path}",
+                   build)
+    assert not (tmp_path / "work" / "train").exists()
+
+
+def test_a_workdir_of_other_models_is_a_usage_error(tmp_path, monkeypatch):
+    from pushjax.paper import runner
+    from pushjax.train import sweep_trainer
+
+    def conflict(spec, workdir):
+        raise sweep_trainer.WorkdirConflictError(f"workdir: {workdir}/train holds a checkpoint of different models")
+
+    monkeypatch.setattr(runner, "run", conflict)
+    with pytest.raises(app.UsageError, match=f"^--workdir: {tmp_path}/train holds a checkpoint of different models$"):
+        run_binary("data_efficiency", "--scale=smoke", f"--workdir={tmp_path}")
+
+
 @pytest.mark.parametrize("binary, last_line", [
     ("data_efficiency", "wrote results.json, results.md and 1 figure (fig5_data_efficiency.png) to {workdir}"),
     ("train", "wrote results.json and 0 sweep folders (checkpoints, metrics.csv) to {workdir}"),

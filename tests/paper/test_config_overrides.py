@@ -28,6 +28,21 @@ def test_overrides_replace_fields_and_are_recorded():
     ({"learning_rate": "fast"}, "config.learning_rate: expected a number, got 'fast'"),
     ({"learning_rate": "-1"}, "config.learning_rate: expected > 0"),
     ({"model.error_features": "1,b"}, "config.model.error_features: expected comma-separated integers"),
+    ({"model.head_features": "64,,32"}, r"config.model.head_features: expected comma-separated integers > 0 \(e.g. "
+                                        r"64,32; no empty item\), got '64,,32'"),
+    ({"model.head_features": "64,"}, "config.model.head_features: expected comma-separated integers > 0"),
+    ({"model.head_features": ",64"}, "config.model.head_features: expected comma-separated integers > 0"),
+    ({"model.head_features": ""}, "config.model.head_features: expected comma-separated integers > 0"),
+    ({"model.head_features": "64,0"}, "config.model.head_features: expected comma-separated integers > 0"),
+    ({"model.head_features": "64,-32"}, "config.model.head_features: expected comma-separated integers > 0"),
+    ({"model.head_features": "64,3.5"}, "config.model.head_features: expected comma-separated integers > 0"),
+    ({"model.head_features": "64;32"}, "config.model.head_features: expected comma-separated integers > 0"),
+    ({"learning_rate": "nan"}, "config.learning_rate: expected a finite number, got 'nan'"),
+    ({"learning_rate": "inf"}, "config.learning_rate: expected a finite number, got 'inf'"),
+    ({"weight_decay": "-1"}, "config.weight_decay: expected >= 0"),
+    ({"num_steps": "1e3"}, "config.num_steps: expected an integer, got '1e3'"),
+    ({"model.glimpse_kernel": "0"}, "config.model.glimpse_kernel: expected a positive kernel side"),
+    ({"model.batch_norm_momentum": "1.5"}, r"config.model.batch_norm_momentum: expected a decay in \[0, 1\]"),
     ({"model.glimpse_features": "8,8"}, "config.model.glimpse_features: expected 3 conv layers"),
     ({"bogus": "1"}, "config.bogus: no such training-config field; expected one of model.glimpse_size"),
     ({"model.variant": "neural"}, r"config.model.variant: no such training-config field \(set by the run itself\)"),
@@ -37,3 +52,12 @@ def test_bad_overrides_name_the_field(overrides, message):
         train_configs.override(train_configs.get_config(spec_lib.data_configs.get_config("data_efficiency", "smoke")),
                                overrides)
     assert "\n" not in str(error.value)
+
+
+@pytest.mark.parametrize(("text", "value"), [("64,32", (64, 32)), (" 64 , 32 ", (64, 32)), ("8", (8,)),
+                                             ("+16,8", (16, 8))])
+def test_integer_lists_accept_what_they_should(text, value):
+    config = train_configs.override(train_configs.get_config(spec_lib.data_configs.get_config("data_efficiency",
+                                                                                               "smoke")),
+                                    {"model.head_features": text})
+    assert config.model.head_features == value

@@ -346,8 +346,10 @@ def test_batch_shapes_broadcast():
 
 def test_check_inputs_accepts_valid_input():
     contact, normal, action, l, mu, s = _random_pushes(np.random.default_rng(4), 10)
-    lynch.check_inputs(contact, normal, action, l, mu, s)
-    lynch.check_inputs([0.0, 0.0], [0.0, 0.0], [0.0, 0.0], 0.04, 0.0)
+    lynch.check_inputs(contact, normal / np.linalg.norm(normal, axis=-1, keepdims=True), action, l, mu, s)
+    lynch.check_inputs([0.0, 0.0], [0.0, 1.0], [0.0, 0.0], 0.04, 0.0)
+    lynch.check_inputs([0.0, 0.0], [0.0, 1.0009], [0.0, 0.0], 0.04, 0.0)  # within the tolerance
+    lynch.check_inputs([0.0, 0.0], np.array([0.6, 0.8], np.float32), [0.0, 0.0], 0.04, 0.0)  # float32 rounding
 
 
 @pytest.mark.parametrize(
@@ -365,11 +367,16 @@ def test_check_inputs_accepts_valid_input():
         ("mu", np.inf, "mu: expected finite values"),
         ("l", np.ones(4), "batch shapes do not broadcast"),
         ("s", "a", "s: expected a real numeric array"),
+        ("normal", [0.0, 0.0], r"normal: expected unit vectors \(length 1 within 0.001\), got length 0 \(a zero "
+                               r"normal predicts no motion\)"),
+        ("normal", np.ones((5, 2)), "normal: expected unit vectors .*, got length 1.41421"),
+        ("normal", np.array([[0.0, 1.0]] * 4 + [[0.0, 1.002]]), "normal: expected unit vectors .*, got length 1.002"),
+        ("normal", [0.0, 0.5], "normal: expected unit vectors .*, got length 0.5"),
     ],
 )
 def test_check_inputs_rejects_bad_input(name, value, message):
     args = dict(
-        contact=np.zeros((5, 2)), normal=np.ones((5, 2)), action=np.ones((5, 2)),
+        contact=np.zeros((5, 2)), normal=np.tile([0.0, 1.0], (5, 1)), action=np.ones((5, 2)),
         l=np.full(5, 0.04), mu=np.full(5, 0.5), s=np.ones(5),
     )
     args[name] = value

@@ -67,3 +67,47 @@ def test_load_model_reads_without_writing_and_names_what_is_wrong(trained, tmp_p
     with pytest.raises(ValueError, match="has no model_config, model_variants in its metadata") as error:
         load_model(tmp_path / "old")
     assert "\n" not in str(error.value)
+
+
+def _damage_state(step):
+    for path in (step / "state").rglob("*"):
+        if path.is_file() and path.name != "commit_success.txt":
+            path.write_bytes(b"garbage")
+
+
+def _damage_arrays(step):
+    for path in (step / "state").rglob("d/*"):
+        path.write_bytes(b"garbage")
+
+
+def _state_replaced_by_a_file(step):
+    for path in sorted((step / "state").rglob("*"), reverse=True):
+        path.unlink() if path.is_file() else path.rmdir()
+    (step / "state").rmdir()
+    (step / "state").write_bytes(b"garbage")
+
+
+def _damage_metadata(step):
+    (step / "metadata" / "metadata").write_bytes(b"{not json")
+
+
+@pytest.mark.parametrize("damage", [_damage_state, _damage_arrays, _state_replaced_by_a_file, _damage_metadata])
+def test_a_damaged_checkpoint_is_one_line_naming_it(tmp_path, damage):
+    checkpointer = Checkpointer(tmp_path / "checkpoints")
+    checkpointer.save(5, {"params": {"w": np.zeros((1, 2), np.float32)}}, {"identity": {"names": ["size=1/seed=0"]}})
+    checkpointer.close()
+    damage(tmp_path / "checkpoints" / "5")
+    with pytest.raises(ValueError, match=f"^path: the checkpoint {tmp_path}/checkpoints/5 cannot be read, a file in it "
+                                         r"is damaged or missing \(.+\); train the model again or restore the folder$"
+                       ) as error:
+        load_model(tmp_path)
+    assert "\n" not in str(error.value) and len(str(error.value)) < 600
+
+
+def test_a_checkpoint_without_a_model_is_named(tmp_path):
+    checkpointer = Checkpointer(tmp_path / "checkpoints")
+    checkpointer.save(5, {"w": np.zeros(2, np.float32)}, {"identity": {"names": ["size=1/seed=0"]}})
+    checkpointer.close()
+    with pytest.raises(ValueError, match=f"^path: the checkpoint {tmp_path}/checkpoints/5 holds no model: expected "
+                                         r"parameters \('params'\)"):
+        load_model(tmp_path)

@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import dataclasses
+import math
+import re
 import typing
 from collections.abc import Callable, Mapping
 
@@ -48,14 +50,26 @@ OVERRIDABLE_FIELDS: dict[str, type] = _field_types(TrainConfig)
 
 
 def _parse(path: str, field_type: type, text: str) -> object:
-    """`text` as a value of `field_type` (int, float, str or a tuple of ints); ValueError naming `path`."""
+    """`text` as a value of `field_type`; ValueError naming ``config.<path>``.
+
+    An int is a whole number (``"64"``), a float a finite number (``"3e-4"``; not ``nan`` or ``inf``), a tuple of
+    ints one or more positive whole numbers separated by commas (``"64,32"``; not ``"64,,32"``, ``"64,"``, ``""`` or
+    ``"64,-1"``), a str any text.
+    """
+    if typing.get_origin(field_type) is tuple:
+        items = [item.strip() for item in text.split(",")]
+        if not all(re.fullmatch(r"\+?[0-9]+", item) and int(item) > 0 for item in items):
+            raise ValueError(f"config.{path}: expected comma-separated integers > 0 (e.g. 64,32; no empty item), "
+                             f"got {text!r}")
+        return tuple(int(item) for item in items)
     try:
-        if typing.get_origin(field_type) is tuple:
-            return tuple(int(item) for item in text.split(",") if item.strip())
-        return field_type(text)
+        value = field_type(text)
     except ValueError:
-        expected = {int: "an integer", float: "a number"}.get(field_type, "comma-separated integers")
+        expected = {int: "an integer", float: "a number"}.get(field_type, f"a {field_type.__name__}")
         raise ValueError(f"config.{path}: expected {expected}, got {text!r}") from None
+    if field_type is float and not math.isfinite(value):
+        raise ValueError(f"config.{path}: expected a finite number, got {text!r}")
+    return value
 
 
 def override(config: TrainConfig, overrides: Mapping[str, str]) -> TrainConfig:

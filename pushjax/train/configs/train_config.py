@@ -45,6 +45,8 @@ class TrainConfig:
                 raise ValueError(f"{name}: expected a positive integer, got {getattr(self, name)}")
         if self.learning_rate <= 0:
             raise ValueError(f"learning_rate: expected > 0, got {self.learning_rate}")
+        if self.weight_decay < 0:
+            raise ValueError(f"weight_decay: expected >= 0, got {self.weight_decay}")
         if self.schedule not in train_state.SCHEDULES:
             raise ValueError(f"schedule: expected one of {', '.join(train_state.SCHEDULES)}, got {self.schedule!r}")
 
