@@ -12,9 +12,9 @@ Where (the first that is set):
 * ``JAX_COMPILATION_CACHE_DIR``, JAX's own variable (the test suite sets it to pytest's cache folder);
 * ``$XDG_CACHE_HOME/pushjax/xla``, by default ``~/.cache/pushjax/xla``.
 
-Programs that compile in under ``jax_persistent_cache_min_compile_time_secs`` (JAX's default 1 s; set
-``JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS`` to change it) are not stored. Library users call `enable` themselves
-(importing pushjax changes no JAX setting).
+Every program is stored, however quickly it compiled (JAX's default skips those under 1 s, and a smoke run's many
+small programs then cost as much as its large ones; ``JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS`` overrides it).
+Library users call `enable` themselves (importing pushjax changes no JAX setting).
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ import jax
 
 ENVIRONMENT = "PUSHJAX_COMPILATION_CACHE"
 OFF = ("off", "0", "false", "none")
+MIN_COMPILE_SECONDS = 0.0
 
 
 def default_folder() -> Path:
@@ -60,4 +61,6 @@ def enable(setting: str | None = None) -> Path | None:
     if not os.access(path, os.W_OK):
         return None
     jax.config.update("jax_compilation_cache_dir", str(path))
+    if "JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS" not in os.environ:
+        jax.config.update("jax_persistent_cache_min_compile_time_secs", MIN_COMPILE_SECONDS)
     return path
