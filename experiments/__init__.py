@@ -16,7 +16,7 @@ from typing import NoReturn
 
 from absl import app, flags
 
-from pushjax import compilation_cache
+from pushjax import compilation_cache, logs
 from pushjax.mit.files import PushFileError
 from pushjax.paper import paths
 from pushjax.sim import testbed
@@ -74,9 +74,11 @@ def run(main) -> None:
     file and the field) print ``error: <message>`` on stderr, without absl's help text or a traceback, and exit with
     `USAGE_ERROR_STATUS`. Before `main`, JAX's persistent compilation cache is enabled
     (`pushjax.compilation_cache`: ``~/.cache/pushjax/xla``; ``PUSHJAX_COMPILATION_CACHE=off`` compiles afresh), so a
-    second run of a command loads the programs the first compiled."""
+    second run of a command loads the programs the first compiled, and the known log noise is dropped
+    (`pushjax.logs`)."""
 
     def main_with_one_line_usage_errors(argv):
+        logs.quiet_known_noise()
         compilation_cache.enable()
         try:
             return main(argv)

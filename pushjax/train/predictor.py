@@ -22,6 +22,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from pushjax import logs
 from pushjax.geometry import THICKNESS
 from pushjax.models import ERROR_OPTIONS, ModelConfig, PushModel
 from pushjax.render.camera import Camera, project
@@ -213,6 +214,7 @@ def load_model(path: str | os.PathLike, model: int | str = 0, step: int | None =
       ValueError: naming what is missing or wrong (no checkpoint, no model configuration in an old checkpoint, an
         unknown model or step, the ``neural_dyn`` variant, which predicts from the true state and not from images).
     """
+    logs.quiet_known_noise()  # orbax's 'Given directory is read only' on every read
     folder = find_checkpoints(path)
     per_model = sorted(child.name for child in folder.iterdir() if _holds_steps(child))
     if per_model and not _holds_steps(folder):
