@@ -203,12 +203,14 @@ def read_training_examples(source, fields: Sequence[str], units: Sequence[Unit])
 def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: TrainingExamples, validation: Mapping,
                test: Mapping, criterion: convergence.Criterion = convergence.CRITERION,
                log: Callable[[str], None] | None = None, tensorboard_dir: str | Path | None = None,
-               checkpoint_dir: str | Path | None = None, resume_dir: str | Path | None = None) -> dict:
+               checkpoint_dir: str | Path | None = None, resume_dir: str | Path | None = None,
+               provenance: Mapping[str, str] | None = None) -> dict:
     """Trains and evaluates one model; returns its record. With `tensorboard_dir`, the model's scores go to the
     TensorBoard run ``<tensorboard_dir>/<unit key>/train`` (from the step it resumes at); with `checkpoint_dir`, its
     parameters to a checkpoint there (`pushjax.train.predictor.save_model`, replacing any earlier one); with
     `resume_dir`, its training state is saved there as it trains and a later call continues from it
-    (`pushjax.train.convergence.train_until_converged`)."""
+    (`pushjax.train.convergence.train_until_converged`). `provenance` is the code's commit (and the diff of changed
+    code, `pushjax.paper.paths.write_source_diff`) as the run started; None: the checkout's commit now."""
     model_spec = train_examples.model_spec(unit)
     size = len(model_spec.train_indices)
     config = train_config(spec, unit)
@@ -242,7 +244,8 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Traini
         "train_seconds": round(trained.seconds, 1), "eval_seconds": round(time.monotonic() - clock, 1),
         "steps_per_second": trained.steps_per_second, "started": started.isoformat(timespec="seconds"),
         "device": device_description(),
-        **({"commit": commit} if (commit := paths.git_commit()) else {}),
+        **(provenance if provenance is not None else
+           ({"commit": commit} if (commit := paths.git_commit()) else {})),
     })
 
 
@@ -316,6 +319,7 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
         _write_json(workdir / "baselines.json", _compact(baseline_rows(spec, test)))
     done = records(workdir)
     todo = [unit for unit in units if needs_training(unit, done, criterion, len(splits["train"]))]
+    provenance = paths.write_source_diff(workdir, paths.source_state())  # the code this process runs
     log(f"{NAME}: {len(units) - len(todo)} of {len(units)} models recorded in {workdir}/models, {len(todo)} to train")
     if todo and (max_models is None or max_models > 0):
         validation = train_lib.examples_from_source(splits["validation"], fields)
@@ -334,7 +338,8 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
                     record = train_unit(spec, unit, train_examples, validation, test, criterion,
                                         lambda line, key=unit.key: log(f"[{key}] {line}"),
                                         workdir / train_lib.metrics_log.TENSORBOARD_DIR,
-                                        workdir / CHECKPOINTS / unit.key, workdir / IN_TRAINING / unit.key)
+                                        workdir / CHECKPOINTS / unit.key, workdir / IN_TRAINING / unit.key,
+                                        provenance)
                 except BaseException:
                     queue.stop()  # no thread starts another model
                     raise

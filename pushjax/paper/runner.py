@@ -227,20 +227,21 @@ def _curve_rows(sweep: TrainedSweep, workdir: Path) -> list[dict]:
             for row in curves_lib.read(path)]
 
 
-def _record_sitting(workdir: Path, commit: str | None, started: datetime.datetime, wall_s: float,
+def _record_sitting(workdir: Path, provenance: Mapping[str, str], started: datetime.datetime, wall_s: float,
                     finished: bool) -> dict:
-    """Writes this call of `run` (of the code at `commit`) into ``<workdir>/invocations.jsonl``, replacing its
-    earlier record, and returns the provenance of ``results.json``: every call's record and their wall time."""
+    """Writes this call of `run` (of the code `provenance` names: its commit and, for changed code, the diff beside
+    the results, `pushjax.paper.paths.write_source_diff`) into ``<workdir>/invocations.jsonl``, replacing its earlier
+    record, and returns the provenance of ``results.json``: every call's record and their wall time."""
     workdir.mkdir(parents=True, exist_ok=True)
     log = workdir / "invocations.jsonl"
-    record = {**({} if commit is None else {"commit": commit}), "started": started.isoformat(timespec="seconds"),
-              "wall_s": round(wall_s, 1), "finished": finished}
+    record = {**provenance, "started": started.isoformat(timespec="seconds"), "wall_s": round(wall_s, 1),
+              "finished": finished}
     invocations = [json.loads(line) for line in log.read_text().splitlines() if line.strip()] if log.exists() else []
     invocations = [entry for entry in invocations if entry["started"] != record["started"]] + [record]
     partial = log.with_name(log.name + ".partial")
     partial.write_text("".join(json.dumps(entry) + "\n" for entry in invocations))
     partial.replace(log)
-    return {**({} if commit is None else {"commit": commit}), "invocations": invocations,
+    return {**provenance, "invocations": invocations,
             "wall_s": round(sum(entry["wall_s"] for entry in invocations), 1)}
 
 
@@ -268,10 +269,10 @@ def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True)
     workdir = Path(workdir)
     started, clock = datetime.datetime.now(datetime.timezone.utc), time.monotonic()
     writer = train_lib.distributed.is_writer()
-    commit = paths.git_commit() if writer else None
+    provenance = paths.write_source_diff(workdir, paths.source_state()) if writer else {}
 
     def record_sitting(finished: bool = False) -> dict | None:
-        return _record_sitting(workdir, commit, started, time.monotonic() - clock, finished) if writer else None
+        return _record_sitting(workdir, provenance, started, time.monotonic() - clock, finished) if writer else None
 
     record_sitting()
     fields = spec.example_fields()

@@ -87,10 +87,10 @@ def test_every_sweep_of_a_run_is_numbered_in_its_label():
 
 def test_a_stopped_sitting_keeps_its_wall_time_and_the_next_one_adds_to_it(tmp_path):
     first = datetime.datetime(2026, 1, 1, 10, 0, tzinfo=datetime.timezone.utc)
-    runner._record_sitting(tmp_path, "abc", first, 0.0, finished=False)
-    runner._record_sitting(tmp_path, "abc", first, 600.0, finished=False)  # after a sweep; then the process is killed
+    runner._record_sitting(tmp_path, {"commit": "abc"}, first, 0.0, finished=False)
+    runner._record_sitting(tmp_path, {"commit": "abc"}, first, 600.0, finished=False)  # after a sweep; then killed
     second = first + datetime.timedelta(hours=1)
-    provenance = runner._record_sitting(tmp_path, "abd", second, 300.0, finished=True)
+    provenance = runner._record_sitting(tmp_path, {"commit": "abd"}, second, 300.0, finished=True)
     assert [(entry["commit"], entry["started"], entry["wall_s"], entry["finished"])
             for entry in provenance["invocations"]] == [("abc", "2026-01-01T10:00:00+00:00", 600.0, False),
                                                        ("abd", "2026-01-01T11:00:00+00:00", 300.0, True)]

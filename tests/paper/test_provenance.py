@@ -1,0 +1,58 @@
+"""A record's provenance: the commit of the code, and the diff of changed code kept beside the record."""
+
+import subprocess
+
+import pytest
+
+from pushjax.paper import paths
+
+
+def _git(root, *arguments):
+    return subprocess.run(["git", *arguments], cwd=root, check=True, capture_output=True, text=True).stdout
+
+
+@pytest.fixture
+def checkout(tmp_path):
+    root = tmp_path / "checkout"
+    (root / "pushjax").mkdir(parents=True)
+    (root / "results").mkdir()
+    (root / "pushjax" / "model.py").write_text("WIDTH = 64\n")
+    (root / "results" / "record.json").write_text("{}\n")
+    (root / "pyproject.toml").write_text("[project]\n")
+    _git(root, "init", "-q")
+    _git(root, "add", ".")
+    _git(root, "-c", "user.name=t", "-c", "user.email=t@t", "commit", "-qm", "code")
+    return root
+
+
+def test_results_do_not_dirty_the_code_and_changed_code_is_kept(checkout, tmp_path):
+    commit = _git(checkout, "rev-parse", "HEAD").strip()
+    (checkout / "results" / "record.json").write_text('{"changed": true}\n')  # a run's own output
+    state = paths.source_state(checkout)
+    assert state == {"commit": commit, "clean": True, "diff": ""}
+    assert paths.git_commit(checkout) == commit
+    assert paths.write_source_diff(tmp_path / "run", state) == {"commit": commit}
+    assert not (tmp_path / "run").exists()
+
+    (checkout / "pushjax" / "model.py").write_text("WIDTH = 128\n")
+    (checkout / "pushjax" / "new_head.py").write_text("DEPTH = 3\n")  # untracked code counts too
+    state = paths.source_state(checkout)
+    assert not state["clean"] and paths.git_commit(checkout) == commit + "+changes"
+    assert "-WIDTH = 64" in state["diff"] and "+WIDTH = 128" in state["diff"]
+    assert "+++ b/pushjax/new_head.py (untracked)" in state["diff"] and "+DEPTH = 3" in state["diff"]
+    provenance = paths.write_source_diff(tmp_path / "run", state)
+    assert provenance["commit"] == commit + "+changes"
+    assert (tmp_path / "run" / provenance["source_diff"]).read_text() == state["diff"]
+    assert paths.write_source_diff(tmp_path / "run", state) == provenance  # the same diff: one file
+    assert len(list((tmp_path / "run" / paths.PROVENANCE_DIR).iterdir())) == 1
+    # The diff applies to the commit and gives the code back.
+    _git(checkout, "stash", "-q", "--include-untracked")
+    tracked = (tmp_path / "run" / provenance["source_diff"]).read_text().split("--- /dev/null")[0]
+    (tmp_path / "tracked.diff").write_text(tracked)
+    _git(checkout, "apply", str(tmp_path / "tracked.diff"))
+    assert (checkout / "pushjax" / "model.py").read_text() == "WIDTH = 128\n"
+
+
+def test_no_checkout_no_provenance(tmp_path):
+    assert paths.source_state(tmp_path) is None and paths.git_commit(tmp_path) is None
+    assert paths.write_source_diff(tmp_path, None) == {}
