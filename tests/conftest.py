@@ -16,7 +16,7 @@ SHARED = pathlib.Path(__file__).resolve().parents[1].parent / "shared"
 
 FAST_COMPILE_XLA_FLAG = "--xla_cpu_use_fusion_emitters=false"
 """XLA:CPU's older loop emitters instead of its fusion emitters: the same programs compile in about half the time
-and run as fast (BUILD.md, issue 34), and about half of the suite's CPU time is compilation."""
+and run as fast (BENCHMARKS.md, "Build and test-suite timings"), and about half of the suite's CPU time is compilation."""
 
 
 def _use_fast_compile_flag() -> None:
