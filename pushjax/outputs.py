@@ -1,11 +1,36 @@
-"""An experiment's outputs in its work directory: ``results.json``, the markdown tables and one figure."""
+"""An experiment's outputs in its work directory: ``results.json``, the markdown tables and one figure; a study's
+``results.json`` and ``results.md`` (`write_report`), its numbers rounded to 7 digits (`compact`)."""
 
 from __future__ import annotations
 
 import json
+import math
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
+
+
+def compact(value):
+    """`value` (nested dicts, lists, tuples) with its floats rounded to 7 significant digits: records stay small and
+    diff well."""
+    if isinstance(value, float):
+        return value if not math.isfinite(value) else float(f"{value:.7g}")
+    if isinstance(value, dict):
+        return {key: compact(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [compact(item) for item in value]
+    return value
+
+
+def write_report(workdir: str | os.PathLike, results: Mapping, markdown: str) -> list[Path]:
+    """Writes ``results.json`` (`compact`) and ``results.md`` (`markdown`) to `workdir` (created); returns their
+    paths."""
+    workdir = Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    paths = [workdir / "results.json", workdir / "results.md"]
+    paths[0].write_text(json.dumps(compact(results), indent=1) + "\n")
+    paths[1].write_text(markdown)
+    return paths
 
 
 def write_results(workdir: str | os.PathLike, results: dict, tables: str, figure_name: str,

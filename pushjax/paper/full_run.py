@@ -29,7 +29,6 @@ from __future__ import annotations
 import dataclasses
 import datetime
 import json
-import math
 import shutil
 import threading
 import time
@@ -39,7 +38,7 @@ from pathlib import Path
 import jax
 import numpy as np
 
-from pushjax import train as train_lib
+from pushjax import outputs, train as train_lib
 from pushjax.models import ModelConfig
 from pushjax.paper import paths, runner, spec as spec_lib
 from pushjax.train import convergence, evaluate
@@ -134,17 +133,6 @@ def needs_training(unit: Unit, done: Mapping[str, dict], criterion: convergence.
     return not criterion.stop_on_plateau and record["row"]["steps"] < criterion.budget(min(unit.size, split_size))
 
 
-def _compact(value):
-    """Floats of nested lists and dicts rounded to 7 significant digits (records stay small and diff well)."""
-    if isinstance(value, float):
-        return value if not math.isfinite(value) else float(f"{value:.7g}")
-    if isinstance(value, dict):
-        return {key: _compact(item) for key, item in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_compact(item) for item in value]
-    return value
-
-
 def _write_json(path: Path, contents) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     partial = path.with_name(path.name + ".partial")
@@ -235,7 +223,7 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Traini
            "train_size": size, "seed": unit.seed, "l_scale": 1.0, "steps": trained.steps,
            "converged": trained.converged, "constant_steps": trained.constant_steps,
            "decay_steps": trained.decay_steps, **metrics}
-    return _compact({
+    return outputs.compact({
         "key": unit.key, "unit": dataclasses.asdict(unit), "row": runner.finite_or_none(row),
         "validation": [{"step": step, "trans_percent": trans, "rot_percent": rot}
                        for step, trans, rot in trained.validation],
@@ -316,7 +304,7 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
     splits = runner.load_splits(spec, spec.dataset, progress)
     test = train_lib.examples_from_source(splits["test"], fields)
     if not (workdir / "baselines.json").exists():
-        _write_json(workdir / "baselines.json", _compact(baseline_rows(spec, test)))
+        _write_json(workdir / "baselines.json", outputs.compact(baseline_rows(spec, test)))
     done = records(workdir)
     todo = [unit for unit in units if needs_training(unit, done, criterion, len(splits["train"]))]
     provenance = paths.write_source_diff(workdir, paths.source_state())  # the code this process runs

@@ -16,13 +16,12 @@ paper's Table 2.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
-from pushjax import train as train_lib
+from pushjax import outputs, train as train_lib
 from pushjax.paper import baselines, full_run, reference, runner, statistics
 from pushjax.physics import lynch
 from pushjax.train import evaluate
@@ -129,8 +128,5 @@ def run(data_dir: str | Path | None, runs: Mapping[str, str | Path], out_dir: st
     test = runner.load_splits(spec, spec.dataset, False)["test"]
     examples = train_lib.examples_from_source(test, spec.example_fields())
     results = analyse(examples, runs, size)
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "results.json").write_text(json.dumps(full_run._compact(results), indent=1) + "\n")
-    (out_dir / "results.md").write_text(markdown(results))
+    outputs.write_report(out_dir, results, markdown(results))
     return results

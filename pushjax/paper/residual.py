@@ -57,7 +57,7 @@ import jax
 import numpy as np
 import tqdm
 
-from pushjax import data, planar
+from pushjax import data, outputs, planar
 from pushjax.data import configs
 from pushjax.geometry import annotate, get_object
 from pushjax.mit import files as mit_files
@@ -648,22 +648,11 @@ def markdown(results: Mapping) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _compact(value):
-    """Floats rounded to 7 significant digits."""
-    if isinstance(value, float):
-        return value if not math.isfinite(value) else float(f"{value:.7g}")
-    if isinstance(value, dict):
-        return {key: _compact(item) for key, item in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_compact(item) for item in value]
-    return value
-
-
 def write(results: Mapping, out_dir: str | Path) -> list[Path]:
     """``results.json`` (lists of numbers on one line each) and ``results.md`` in ``out_dir``; their paths."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    text = json.dumps(_compact(results), indent=1)
+    text = json.dumps(outputs.compact(results), indent=1)
     text = re.sub(r"\[([^\[\]{}\"]*)\]", lambda match: "[" + " ".join(match.group(1).split()) + "]", text)
     paths = [out_dir / "results.json", out_dir / "results.md"]
     paths[0].write_text(text + "\n")

@@ -15,10 +15,10 @@ stopped it:
 from __future__ import annotations
 
 import dataclasses
-import json
 from collections.abc import Mapping
 from pathlib import Path
 
+from pushjax import outputs
 from pushjax.paper import full_run
 from pushjax.train import stopping
 
@@ -88,8 +88,6 @@ def markdown(results: Mapping) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write(results: Mapping, out_dir: str | Path) -> None:
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "results.json").write_text(json.dumps(full_run._compact(results), indent=1) + "\n")
-    (out_dir / "results.md").write_text(markdown(results))
+def write(results: Mapping, out_dir: str | Path) -> list[Path]:
+    """``results.json`` and ``results.md`` of the audit in `out_dir`; their paths."""
+    return outputs.write_report(out_dir, results, markdown(results))
