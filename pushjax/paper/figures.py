@@ -163,7 +163,7 @@ def curves_figure(curves: Sequence[Mapping], path: str | os.PathLike) -> Path:
     set (training split, size and l scale; darker: later in that order, i.e. larger), each named in the legend
     by what varies among them."""
     means = _curve_means(curves)
-    models = sorted({key[0] for key in means}, key=lambda m: MODEL_ORDER.index(m) if m in MODEL_ORDER else 99)
+    models = sorted({key[0] for key in means}, key=lambda m: (MODEL_ORDER.index(m) if m in MODEL_ORDER else len(MODEL_ORDER), m))
     several = {"train_split": len({key[1] for key in means}) > 1, "l_scale": len({key[3] for key in means}) > 1}
     columns = min(4, len(models))
     rows = -(-len(models) // columns)
