@@ -40,6 +40,7 @@ from pathlib import Path
 import jax
 import matplotlib.pyplot as plt
 import numpy as np
+import tqdm
 
 from pushjax import outputs, planar
 from pushjax.filter import constant_velocity, ekf, metrics, models, noise, particle, ukf
@@ -138,7 +139,7 @@ def simulate_pushes(objects: Sequence[str], pushes: int, seed: int, testbed: Tes
     jobs = dataset.plan_pushes("unused", list(objects), ["abs"], pushes,
                                dataset.RecordingSettings(seed=seed, velocities=(velocity,), testbed=testbed))
     result = []
-    for job in jobs:
+    for job in tqdm.tqdm(jobs, unit="push", desc="track: simulating the pushes"):
         recording = dataset.simulate_job(job)
         conditions = dataset.job_conditions(job)
         indices = np.arange(0, len(recording.tip_pose), step)
@@ -249,7 +250,8 @@ def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, parti
                     "seconds_with_compile": time.perf_counter() - start}
     per_push, estimates = [], {name: [] for name in (*filters, "constant_velocity", "raw")}
     truths, valid_masks = [], []
-    for system, group, batch in batches_by_object(pushes):
+    for system, group, batch in tqdm.tqdm(batches_by_object(pushes), unit="object",
+                                          desc="track: filtering each object's pushes"):
         obj, count = group[0].obj, len(group)
         paths, measured, truth, valid = batch.pusher, batch.measurements, batch.truth, batch.valid
         tracks, seconds = {}, {}
