@@ -8,6 +8,13 @@ annotation ``pushjax.geometry.contact.annotate`` and the NumPy reference model o
 ``--numpy_pushes`` pushes. Prints a markdown table.
 
     python benchmarks/rollout.py [--pushes=1000] [--steps=100] [--objects=rect1,ellip2,butter] [--repeats=5]
+        [--searches=full,local]
+
+``--searches`` compares the contact searches in one sitting on the same pushes: ``full`` is the former rollout
+(every outline feature every step, the outline unpadded: a program per vertex count), ``local`` the current one
+(the window around the tracked feature, the outline padded to 256 vertices: one program for every object). The
+jitted functions take the outline as an argument, so a search's first call on a later object shows whether it
+compiled again.
 
 Times are the median (and best) over ``--repeats`` calls after a warm-up (compiling) call, with
 ``block_until_ready``; the compile time of the first call is given separately.
@@ -36,6 +43,8 @@ _OBJECTS = flags.DEFINE_list("objects", ["rect1", "ellip2", "butter"], "Objects 
 _REPEATS = flags.DEFINE_integer("repeats", 5, "Timed calls per measurement.")
 _NUMPY_PUSHES = flags.DEFINE_integer("numpy_pushes", 1000, "Pushes of the NumPy baseline's batch.")
 _SEED = flags.DEFINE_integer("seed", 0, "Seed of the random pushes.")
+_SEARCHES = flags.DEFINE_list("searches", ["full", "local"],
+                              "Contact searches: full (unpadded outline, every feature) and/or local (padded, tracked).")
 
 _REFERENCE_PATH = pathlib.Path(__file__).resolve().parents[1] / "tests" / "physics" / "numpy_lynch.py"
 
@@ -78,37 +87,49 @@ def main(argv):
     count, steps = _PUSHES.value, _STEPS.value
     print(f"{platform.processor() or platform.machine()}, {jax.devices()[0].platform}, jax {jax.__version__}; "
           f"{count} pushes x {steps} steps, float32, median (best) of {_REPEATS.value}\n")
-    print("| object | pass | first call (s) | time (s) | rollouts/s | steps/s |")
-    print("|---|---|---:|---:|---:|---:|")
+    print("| object | search | pass | first call (s) | time (s) | rollouts/s | steps/s |")
+    print("|---|---|---|---:|---:|---:|---:|")
+    functions = {search: _functions(search) for search in _SEARCHES.value}
     for name in _OBJECTS.value:
-        _measure(name, count, steps, reference)
+        _measure(name, count, steps, reference, functions)
 
 
-def _measure(name, count, steps, reference):
+def _functions(search):
+    """(forward, gradient) of a batch of rollouts with `search`, jitted once, the outline an argument."""
+
+    def final(shape, path, pose, l, mu):
+        return rollout.rollout(shape, pose, path, l, mu, search=search).poses[-1]
+
+    forward = jax.jit(jax.vmap(final, in_axes=(None, 0, 0, 0, 0)))
+    gradient = jax.jit(jax.vmap(jax.grad(lambda *args: jnp.sum(final(*args)), argnums=(1, 3, 4)),
+                                in_axes=(None, 0, 0, 0, 0)))
+    return forward, gradient
+
+
+def _measure(name, count, steps, reference, functions):
     """Prints the rows of one object."""
     obj = get_object(name)
     paths, mus = random_pushes(obj, count, steps, _SEED.value)
-    shape = outline_jax.outline(obj)
     l = jnp.full(count, limit_surface_ratio(obj), jnp.float32)
     paths_j, mus_j = jnp.asarray(paths, jnp.float32), jnp.asarray(mus, jnp.float32)
     poses0 = jnp.zeros((count, 3))
-
-    def final(path, pose, l, mu):
-        return rollout.rollout(shape, pose, path, l, mu).poses[-1]
-
-    forward = jax.jit(jax.vmap(final))
-    gradient = jax.jit(jax.vmap(jax.grad(lambda *args: jnp.sum(final(*args)), argnums=(0, 2, 3))))
-    for label, function in [("forward", lambda: forward(paths_j, poses0, l, mus_j)),
-                            ("grad w.r.t. path, l, mu", lambda: gradient(paths_j, poses0, l, mus_j))]:
-        first, median, best = time_calls(function, _REPEATS.value)
-        print(f"| {name} | {label} | {first:.1f} | {median:.3f} ({best:.3f}) | {count / median:,.0f} "
-              f"({count / best:,.0f}) | {count * steps / median:,.0f} |")
+    for search, (forward, gradient) in functions.items():
+        shape = outline_jax.outline(obj, pad_to=None if search == "full" else outline_jax.PADDED_VERTICES)
+        label = f"{search} ({int(shape.count)} of {shape.start.shape[0]} vertices)"
+        for pass_, function in [("forward", forward), ("grad w.r.t. path, l, mu", gradient)]:
+            first, median, best = time_calls(lambda function=function: function(shape, paths_j, poses0, l, mus_j),
+                                             _REPEATS.value)
+            print(f"| {name} | {label} | {pass_} | {first:.1f} | {median:.3f} ({best:.3f}) | {count / median:,.0f} "
+                  f"({count / best:,.0f}) | {count * steps / median:,.0f} |", flush=True)
     numpy_count = min(_NUMPY_PUSHES.value, count)
+    if numpy_count == 0:
+        return
     start = time.perf_counter()
     numpy_rollouts(obj, paths[:numpy_count], limit_surface_ratio(obj), mus[:numpy_count], reference)
     elapsed = time.perf_counter() - start
-    print(f"| {name} | NumPy loop, float64 ({numpy_count} pushes) | | {elapsed:.3f} | {numpy_count / elapsed:,.0f} "
-          f"| {numpy_count * steps / elapsed:,.0f} |")
+    print(f"| {name} | NumPy loop, float64 ({numpy_count} pushes) | | | {elapsed:.3f} | {numpy_count / elapsed:,.0f} "
+          f"| {numpy_count * steps / elapsed:,.0f} |", flush=True)
+
 
 if __name__ == "__main__":
     app.run(main)

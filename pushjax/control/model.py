@@ -35,6 +35,8 @@ class PushModel:
       support: the object's support (:func:`pushjax.physics.rollout.object_support`), which the exact limit
         surface (``limit_surface``) needs; None for the other models.
       effects: names of the composed effects (static; () is plain Lynch).
+      search: the rollout's contact search (static; :func:`pushjax.physics.rollout.rollout`): "local" (around the
+        tracked contact) or "full" (every outline feature every step, the former search, for comparison).
     """
 
     shape: outline_jax.Outline
@@ -44,6 +46,7 @@ class PushModel:
     params: dict
     support: rollout.Support | None = None
     effects: tuple[str, ...] = flax.struct.field(pytree_node=False, default=())
+    search: str = flax.struct.field(pytree_node=False, default="local")
 
 
 def make_model(obj: PushObject | str, mu: float = 0.25, l: float | None = None, *, effects: Sequence[str] = (),
@@ -74,4 +77,4 @@ def make_model(obj: PushObject | str, mu: float = 0.25, l: float | None = None, 
 def predict(model: PushModel, pose, pusher_path) -> rollout.Rollout:
     """The model's rollout from `pose` [3] (x m, y m, yaw rad) along `pusher_path` [T + 1, 2] (world, m)."""
     return rollout.rollout(model.shape, pose, pusher_path, model.l, model.mu, model.params, effects=model.effects,
-                           radius=model.radius, support=model.support)
+                           radius=model.radius, support=model.support, search=model.search)

@@ -176,7 +176,9 @@ def pose_from_contact(obj: str, com: np.ndarray, contact: np.ndarray, normal: np
       normal: [2] estimated inward normal at the contact, world (any length > 0).
     """
     shape = _outline(obj)
-    start, edge, outward, centroid = (np.asarray(a, np.float64) for a in shape)
+    count = int(shape.count)  # the outline is padded past its real vertices
+    start, edge, outward = (np.asarray(a, np.float64)[:count] for a in (shape.start, shape.edge, shape.outward))
+    centroid = np.asarray(shape.centroid, np.float64)
     yaw = math.atan2(normal[1], normal[0]) - np.arctan2(-outward[:, 1], -outward[:, 0])
     local = centroid + planar.rotate(np.broadcast_to(np.asarray(contact, np.float64), (len(yaw), 2)), -yaw)
     along = np.clip(np.sum((local - start) * edge, -1) / np.sum(edge * edge, -1), 0.0, 1.0)

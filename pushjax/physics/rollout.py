@@ -3,11 +3,13 @@
 A push of several centimetres is the sum of many small steps: at every step the contact is annotated
 again on the object's outline where the object now is (:func:`pushjax.geometry.outline_jax.first_contact`:
 which feature the disc pusher touches, where, the inward normal, and how far the pusher travels before it
-touches, so the contact is lost and regained as the path says), and the step's object motion comes from
+touches, so the contact is lost and regained as the path says; the scan carries the touched feature, and each step
+searches a few edges around it, the whole outline only where that cannot prove its choice, so a step costs O(1)
+in the outline's vertices), and the step's object motion comes from
 the pushing model :func:`pushjax.physics.effects.compose` of any effects (none: plain Lynch). The loop is a
 ``jax.lax.scan``, so :func:`rollout` is pure and jit-, vmap- and grad-friendly:
 
-    shape = outline_jax.outline("rect1")
+    shape = outline_jax.outline("rect1")  # padded to 256 vertices: one program for every object
     poses = rollout(shape, pose, pusher_path, l, mu).poses                   # [T + 1, 3]
     jax.grad(lambda mu: rollout(shape, pose, pusher_path, l, mu).poses[-1, 2])(mu)
     jax.vmap(rollout, in_axes=(None, 0, 0, 0, 0))(shape, poses, paths, ls, mus)  # many pushes
@@ -111,7 +113,7 @@ def _safe_norm(vector):
 
 def step(predict, params, shape: outline_jax.Outline, pose, pusher, increment, l, mu,
          radius=PUSHER_RADIUS, step_time=1.0, time_after_stop=0.0,
-         support: Support | None = None) -> tuple[jax.Array, StepInfo]:
+         support: Support | None = None, *, feature=None, search: str = "local") -> tuple[jax.Array, StepInfo]:
     """One step of a rollout: annotate the contact where the object is, predict, move the object.
 
     Args:
@@ -127,13 +129,25 @@ def step(predict, params, shape: outline_jax.Outline, pose, pusher, increment, l
       step_time: [] duration of the step, s (only for the pusher speed of a slide after a stop).
       time_after_stop: [] time from the pusher's stop at the step's end to the end of the window, s.
       support: the object's :class:`Support` (needed by ``limit_surface``; None: unknown).
+      feature: [] int, the outline's edge to search the contact around (None: a guess from the pusher's bearing);
+        changes no result (:func:`pushjax.geometry.outline_jax.first_contact`).
+      search: the contact search, "local" or "full" (:func:`pushjax.geometry.outline_jax.first_contact`).
 
     Returns:
       ([3] the pose after the step, the step's :class:`StepInfo`).
     """
+    new_pose, info, _ = _step(predict, params, shape, pose, pusher, increment, l, mu, radius, step_time,
+                              time_after_stop, support, feature, search)
+    return new_pose, info
+
+
+def _step(predict, params, shape, pose, pusher, increment, l, mu, radius, step_time, time_after_stop, support,
+          feature, search):
+    """:func:`step`, and the edge to search the next step's contact around."""
     pose = jnp.asarray(pose)
     yaw = pose[2]
-    local = outline_jax.first_contact(shape, _rotate(pusher - pose[:2], -yaw), _rotate(increment, -yaw), radius)
+    local = outline_jax.first_contact(shape, _rotate(pusher - pose[:2], -yaw), _rotate(increment, -yaw), radius,
+                                      feature, search)
     com = pose[:2] + _rotate(shape.centroid, yaw)
     touches = local.touches
     contact = _rotate(local.point - shape.centroid, yaw)
@@ -150,13 +164,13 @@ def step(predict, params, shape: outline_jax.Outline, pose, pusher, increment, l
     new_com = com + twist[:2]
     new_pose = jnp.concatenate([new_com - _rotate(shape.centroid, new_yaw), new_yaw[None]])
     return new_pose, StepInfo(touches=touches, fraction=local.fraction, contact=contact, normal=normal,
-                              twist=twist)
+                              twist=twist), local.feature
 
 
-@functools.partial(jax.jit, static_argnames=("effects",))
+@functools.partial(jax.jit, static_argnames=("effects", "search"))
 def rollout(shape: outline_jax.Outline, object_pose, pusher_path, l, mu, params=None, *,
             effects: Sequence[str] = (), radius=PUSHER_RADIUS, step_time=1.0, time_after_stop=0.0,
-            support: Support | None = None) -> Rollout:
+            support: Support | None = None, search: str = "local") -> Rollout:
     """Object poses along a pusher path predicted by the pushing model, one step per path segment.
 
     Args:
@@ -172,6 +186,9 @@ def rollout(shape: outline_jax.Outline, object_pose, pusher_path, l, mu, params=
       step_time: [] duration of one step, s (the pusher speed of the slide after the stop).
       time_after_stop: [] time from the pusher's stop (the path's end) to the end of the rollout, s.
       support: the object's :class:`Support` (:func:`object_support`); needed by ``limit_surface``.
+      search: the contact search (static): "local" (each step searches around the previous step's contact
+        feature, the full search only where that cannot prove its choice) or "full" (every feature every step,
+        the former search); the same results.
 
     Returns:
       The :class:`Rollout`: poses [T + 1, 3] and the steps' :class:`StepInfo` [T, ...].
@@ -192,13 +209,17 @@ def rollout(shape: outline_jax.Outline, object_pose, pusher_path, l, mu, params=
     starts, increments = pusher_path[:-1], jnp.diff(pusher_path, axis=0)
     stop_times = jnp.zeros(len(increments), dtype).at[-1].set(time_after_stop)
 
-    def body(pose, inputs):
-        pusher, increment, stop_time = inputs
-        new_pose, info = step(predict, params, shape, pose, pusher, increment, l, mu, radius, step_time, stop_time,
-                              support)
-        return new_pose, (new_pose, info)
+    # The contact feature is carried from step to step: each step searches around the previous one's.
+    first_feature = outline_jax.initial_feature(shape, _rotate(pusher_path[0] - pose[:2], -pose[2]))
 
-    _, (poses, infos) = jax.lax.scan(body, pose, (starts, increments, stop_times))
+    def body(carry, inputs):
+        pose, feature = carry
+        pusher, increment, stop_time = inputs
+        new_pose, info, feature = _step(predict, params, shape, pose, pusher, increment, l, mu, radius, step_time,
+                                        stop_time, support, feature, search)
+        return (new_pose, feature), (new_pose, info)
+
+    _, (poses, infos) = jax.lax.scan(body, (pose, first_feature), (starts, increments, stop_times))
     return Rollout(poses=jnp.concatenate([pose[None], poses]), steps=infos)
 
 
