@@ -14,7 +14,6 @@ many it found and how many it needs.
 """
 
 import dataclasses
-import json
 import math
 import sys
 
@@ -72,10 +71,25 @@ def main(argv):
     if not all(round_.converged for round_ in result.details.rounds):
         print(f"warning: the fits had not converged at --steps={_STEPS.value}: selection stopped early "
               f"(report.md, \"Forward selection\"); rerun with more --steps", file=sys.stderr)
-    summary = {key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "noise_floor", "explained",
-                                            "fallback", "remaining")}
-    print(json.dumps(summary, indent=2))
-    print(f"wrote report.json, details.json, model.json, report.md and figures/ to {_WORKDIR.value}")
+    print(summary(report, _WORKDIR.value))
+
+
+def summary(report: dict, workdir: str) -> str:
+    """A few lines of ``report.json`` (its content as :meth:`pushjax.loop.report.LoopReport.as_dict` gives it)."""
+
+    def errors(scores: dict) -> str:
+        return f"{scores['trans_percent']:.1f} / {scores['rot_percent']:.1f}"
+
+    remaining = [entry["variable"] for entry in report["remaining"]["variables"]]
+    return "\n".join([
+        f"{report['n_pushes']} pushes; selected: {', '.join(report['selected']) or 'nothing (plain Lynch)'}",
+        f"test error, % of zero (translation / rotation): plain Lynch {errors(report['baseline'])}, selected "
+        f"{errors(report['after'])}, with the learned error term {errors(report['fallback'])}; noise floor "
+        f"{errors(report['noise_floor'])}",
+        f"explained: {'yes' if report['explained'] else 'no'} ({errors(report['remaining']['above_floor'])} points "
+        f"above the floor){'; the residual still depends on ' + ', '.join(remaining) if remaining else ''}",
+        f"wrote report.json, details.json, model.json, report.md and figures/ to {workdir}",
+    ])
 
 
 if __name__ == "__main__":

@@ -43,7 +43,8 @@ def test_writes_the_report_and_continues_an_unconverged_fit(record, tmp_path):
     second = json.loads((tmp_path / "out" / "details.json").read_text())["rounds"][1]
     assert second["continuations"] >= 1 and second["converged"] and "the fits had not converged" not in result.stderr
     assert sorted(entry["effect"] for entry in report["ranking"]) == ["limit_surface", "table_tilt"]
-    assert json.loads(result.stdout[:result.stdout.rindex("}") + 1])["selected"] == report["selected"]
+    lines = result.stdout.strip().splitlines()
+    assert len(lines) == 4 and lines[0].endswith("selected: limit_surface") and lines[-1].startswith("wrote ")
     assert (tmp_path / "out" / "report.md").is_file() and (tmp_path / "out" / "details.json").is_file()
     assert model_file.read(tmp_path / "out" / "model.json").effects == tuple(report["selected"])
 
