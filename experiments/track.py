@@ -1,7 +1,7 @@
 r"""Track pushes of the testbed with the EKF, UKF and particle filter, and infer the pusher friction.
 
   python -m experiments.track --workdir=work/track [--scale=smoke|cpu] [--filters=ekf,ukf,particle,ekf_learned]
-      [--seed=0] [--rate_hz=10] [--learn_steps=200] [--testbed=realistic|ideal] [--testbed_overrides='drop_rate=0.1']
+      [--seed=0 | --seeds=1,2,3] [--rate_hz=10] [--learn_steps=200] [--testbed=realistic|ideal] [--testbed_overrides='drop_rate=0.1']
       [--perception=<a trained model's work directory or checkpoint> [--perception_hz=2.5] [--perception_scale=cpu]]
 
 Simulates the scale's pushes in memory (``pushjax.filter.tracking``: the truth only the simulation knows), filters
@@ -16,14 +16,21 @@ locates in the depth image of the true scene, rendered at ``--perception_hz`` as
 estimated on the pushes of seed ``--seed`` + 1, never on the evaluated ones. Rows ``ekf_perception`` (motion capture
 and perception), ``ekf_perception_only`` (perception after the first motion-capture sample) and ``perception`` (the
 readings themselves). The model's folder is only read.
+
+``--seeds=1,2,3`` runs each seed into ``--workdir/seed<k>/`` (a seed whose ``results.json`` is there is read, not run
+again) and writes to ``--workdir`` the filters' position errors per seed and their paired comparisons over the pushes
+of every seed but the one the process noise was tuned on (``pushjax.filter.tracking.compare_over_seeds``).
 """
 
+import json
 import math
+from pathlib import Path
 
 from absl import app, flags
 
 import experiments
 from pushjax.data import configs as data_configs
+from pushjax import outputs
 from pushjax.filter import tracking
 from pushjax.sensing import perception
 
@@ -32,6 +39,8 @@ _SCALE = flags.DEFINE_enum("scale", "cpu", list(tracking.SCALES), "Objects, push
 _FILTERS = flags.DEFINE_list("filters", list(tracking.FILTERS), f"Filters, from {','.join(tracking.FILTERS)}.")
 _SEED = flags.DEFINE_integer("seed", 0, "Seed of the pushes, the testbed's draws and the particle filter.",
                              lower_bound=0)
+_SEEDS = flags.DEFINE_list("seeds", None, "Several seeds, each run into --workdir/seed<k>/, and their comparison over "
+                           f"the seeds but the tuning seed {tracking.TUNING_SEED}.")
 _RATE = flags.DEFINE_float("rate_hz", None, "Filter rate, Hz: 250 divided by a whole number (default: the scale's).")
 _LEARN_STEPS = flags.DEFINE_integer("learn_steps", None,
                                     "Adam steps of ekf_learned's noise (default: the scale's).")
@@ -64,6 +73,16 @@ def _check_rate(value):
     return abs(step - round(step)) < 1e-9
 
 
+@flags.validator("seeds", "expected distinct seeds >= 0, at least one of them not the tuning seed "
+                          f"{tracking.TUNING_SEED}")
+def _check_seeds(values):
+    if values is None:
+        return True
+    if not all(value.isdigit() for value in values) or len(set(map(int, values))) != len(values):
+        return False
+    return any(int(value) != tracking.TUNING_SEED for value in values)
+
+
 @flags.validator("learn_steps", "expected a whole number of steps >= 1")
 def _check_learn_steps(value):
     return value is None or value >= 1
@@ -72,6 +91,8 @@ def _check_learn_steps(value):
 def main(argv):
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
+    if _SEEDS.value is not None and flags.FLAGS["seed"].present:
+        raise app.UsageError("--seed: give --seed or --seeds, not both")
     testbed = experiments.testbed_from_flags(_TESTBED.value, _TESTBED_OVERRIDES.value)
     scale = tracking.SCALES[_SCALE.value]
     rate = _RATE.value or scale["rate_hz"]
@@ -91,22 +112,50 @@ def main(argv):
             sensor = perception.load_data_efficiency(_PERCEPTION.value, _PERCEPTION_SCALE.value)
         except ValueError as error:
             raise app.UsageError(f"--perception: {' '.join(str(error).split())}") from None
-    pushes = tracking.simulate_pushes(scale["objects"], scale["pushes"], _SEED.value, testbed, rate)
-    training_seed = _SEED.value + tracking.TRAINING_SEED_OFFSET
+    if _SEEDS.value is None:
+        paths = tracking.write(_run_seed(_SEED.value, testbed, rate, sensor, round(every)), _WORKDIR.value)
+        print(paths[1].read_text())
+        print(f"wrote {', '.join(str(path) for path in paths)}")
+        return
+    records = []
+    for seed in map(int, _SEEDS.value):
+        folder = Path(_WORKDIR.value) / f"seed{seed}"
+        if (folder / "results.json").is_file():
+            record = json.loads((folder / "results.json").read_text())
+            if (record.get("scale"), record.get("filters", [])[:len(_FILTERS.value)]) != (_SCALE.value, _FILTERS.value):
+                raise app.UsageError(f"--workdir: {folder} holds a run of other settings (scale, filters): use a fresh "
+                                     f"--workdir")
+            print(f"seed {seed}: read {folder / 'results.json'}")
+        else:
+            record = _run_seed(seed, testbed, rate, sensor, round(every))
+            tracking.write(record, folder)
+        records.append(record)
+    comparison = tracking.compare_over_seeds(records)
+    table = tracking.seeds_table(comparison)
+    paths = outputs.write_report(_WORKDIR.value, {"scale": _SCALE.value, "seeds": [int(s) for s in _SEEDS.value],
+                                                  **comparison}, table)
+    print(table)
+    print(f"wrote {', '.join(str(path) for path in paths)}")
+
+
+def _run_seed(seed: int, testbed, rate: float, sensor, every: int) -> dict:
+    """The results of :func:`pushjax.filter.tracking.run` on the pushes of `seed` at the flags' scale and filters."""
+    scale = tracking.SCALES[_SCALE.value]
+    learns = "ekf_learned" in _FILTERS.value
+    pushes = tracking.simulate_pushes(scale["objects"], scale["pushes"], seed, testbed, rate)
+    training_seed = seed + tracking.TRAINING_SEED_OFFSET
     training_pushes = (tracking.simulate_pushes(scale["objects"], scale["pushes"], training_seed, testbed, rate)
                        if learns or sensor is not None else [])
-    readings = (perception.stream(sensor, pushes, training_pushes, round(every), rate, training_seed)
+    readings = (perception.stream(sensor, pushes, training_pushes, every, rate, training_seed)
                 if sensor is not None else None)
     measurement_std = (max(testbed.tracking_noise_xy, 1e-5), max(testbed.tracking_noise_xy, 1e-5),
                        max(testbed.tracking_noise_yaw, 1e-4))
-    results = tracking.run(pushes, _FILTERS.value, rate, scale["particles"], _SEED.value, measurement_std,
+    results = tracking.run(pushes, _FILTERS.value, rate, scale["particles"], seed, measurement_std,
                            training_pushes if learns else (), _LEARN_STEPS.value or scale["learn_steps"], readings)
-    results.update(scale=_SCALE.value, seed=_SEED.value, testbed=testbed.to_dict())
+    results.update(scale=_SCALE.value, seed=seed, testbed=testbed.to_dict())
     if learns or sensor is not None:
         results.update(training_seed=training_seed)
-    paths = tracking.write(results, _WORKDIR.value)
-    print(paths[1].read_text())
-    print(f"wrote {', '.join(str(path) for path in paths)}")
+    return results
 
 
 if __name__ == "__main__":

@@ -7,6 +7,9 @@ independent: uncertainty comes from resampling whole sequences (`resample_sequen
 
 * `SEQUENCE_RATIOS` names each evaluation metric by the per-sequence sums it is a ratio of (``trans_percent``:
   100 x translation error / the ``zero`` baseline's, in mm); `bootstrap_replicates` resamples it.
+* `decide` is the project's one decision rule: every verdict of an experiment (the paper's findings, the rollouts'
+  expectations, the push-to-goal comparisons) is a paired difference against `DECISION_STANDARD_ERRORS` of its
+  standard error, or the larger `SEQUENTIAL_STANDARD_ERRORS` when the same question is looked at more than once.
 """
 
 from __future__ import annotations
@@ -65,3 +68,52 @@ def bootstrap_replicates(sequences: Mapping[str, Sequence[float]], metric: str) 
     weights = sequence_bootstrap_weights(sequences["id"])
     return factor * (weights @ np.asarray(sequences[numerator], np.float64)) / (
         weights @ np.asarray(sequences[denominator], np.float64))
+
+
+DECISION_STANDARD_ERRORS = 2.0
+"""The project's decision rule: a paired difference (better − worse, in the difference's own unit) decides a
+comparison when it lies more than this many of its standard errors from zero (`decide`). The standard error is
+that of the *paired* difference, and each caller names its unit of resampling: push sequences of a test split (with
+the spread over world seeds where several were trained: `pushjax.paper.statistics`) for the paper's findings and
+the rollouts' expectations; goals for the push-to-goal comparisons (`pushjax.control.report.compare`). At one look
+this is the two-sided 5 % level of a normal difference (1.96), rounded up."""
+
+SEQUENTIAL_STANDARD_ERRORS = {1: DECISION_STANDARD_ERRORS, 2: 2.178, 3: 2.289, 4: 2.361, 5: 2.413}
+"""looks -> the bound of `decide` when the same comparison is looked at that many times as its data grow (equally
+spaced looks; Pocock's two-sided boundary at the 5 % level for two and more). A verdict of a later look uses its
+look's bound, and the record says how many looks were taken."""
+
+HOLDS, FAILS, UNDECIDED = "holds", "does not hold", "not decided"
+"""The verdicts of `decide`: the difference is below −bound standard errors (the claim "better beats worse"
+holds), above +bound (it does not hold: worse beats better), or in between (not decided with these data)."""
+
+
+def decision_bound(looks: int = 1) -> float:
+    """Standard errors a difference must exceed at the last of `looks` looks (`SEQUENTIAL_STANDARD_ERRORS`).
+
+    Raises:
+      ValueError: `looks` is not one of `SEQUENTIAL_STANDARD_ERRORS`' keys (1-5).
+    """
+    if looks not in SEQUENTIAL_STANDARD_ERRORS:
+        raise ValueError(f"looks: expected one of {sorted(SEQUENTIAL_STANDARD_ERRORS)}, got {looks}")
+    return SEQUENTIAL_STANDARD_ERRORS[looks]
+
+
+def decide(difference: float, standard_error: float | None, looks: int = 1) -> str:
+    """The verdict on the claim "better beats worse" from their paired difference (better − worse, lower is better).
+
+    Args:
+      difference: better − worse, in the compared quantity's unit (e.g. points of % of zero, s).
+      standard_error: the standard error of `difference`, same unit; None, NaN or infinite: unknown, so not decided.
+      looks: how many times this comparison has been looked at, this one included (`decision_bound`).
+
+    Returns:
+      `HOLDS` when `difference` < −bound × `standard_error`, `FAILS` when it is > +bound × `standard_error`, else
+      `UNDECIDED` (also for a NaN `difference`).
+    """
+    bound = decision_bound(looks)
+    if standard_error is None or not np.isfinite(standard_error) or not np.isfinite(difference):
+        return UNDECIDED
+    if difference < -bound * standard_error:
+        return HOLDS
+    return FAILS if difference > bound * standard_error else UNDECIDED

@@ -250,6 +250,10 @@ CASES = [
       for value in values],
     ("track", ["--workdir={tmp}/track", "--learn_steps=5", "--filters=ekf,ukf"], "--learn_steps"),
     ("track", ["--workdir={tmp}/track", "extra"], "unexpected arguments"),
+    ("track", ["--workdir={tmp}/track", "--seeds=0"], "--seeds"),
+    ("track", ["--workdir={tmp}/track", "--seeds=1,1"], "--seeds"),
+    ("track", ["--workdir={tmp}/track", "--seeds=1,x"], "--seeds"),
+    ("track", ["--workdir={tmp}/track", "--seed=1", "--seeds=2,3"], "--seed"),
     ("track", ["--workdir={tmp}/track", "--perception={tmp}/missing"], "--perception"),
     ("track", ["--workdir={tmp}/track", "--perception={empty}"], "--perception"),
     # push_to_goal
