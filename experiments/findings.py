@@ -4,7 +4,7 @@ r"""Which of the paper's qualitative findings hold, from the results of the expe
 
 Each DIR is the --workdir of a finished run of data_efficiency, data_efficiency_full, new_pushes, velocities,
 error_velocities, error_variants or objects; prints (and with --output writes) a markdown table: the paper's finding,
-the verdict on our testbed (holds / does not hold / not decidable / not checked / not reached at N, criteria in
+the verdict on our testbed (holds / does not hold / not decided / not checked / not reached at N, criteria in
 `pushjax.paper.findings`) and the numbers behind it.
 
 With --replace_with=DIR (a ``data_efficiency_full``-style run of some of its cells, e.g. the models at the full split

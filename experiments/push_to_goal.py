@@ -6,7 +6,7 @@ r"""Push objects to goal poses with model-predictive control, closed on the MuJo
       [--planners=gradient,sampling] [--seed=0] [--surface=abs] [--testbed=realistic|ideal]
       [--testbed_overrides='drop_rate=0'] [--effects='table_tilt_deg=2'] [--max_time=60]
       [--states=mocap,mocap+perception,perception --perception=<a trained model's work directory or checkpoint>
-       [--perception_scale=cpu] [--perception_every=1] [--perception_gate=13.8]]
+       [--perception_scale=cpu] [--perception_every=1] [--perception_gate=13.8]] [--looks=1]
 
 Draws the goals (``pushjax.control.goals``), runs every model and planner on each (``pushjax.control.push_to_goal``,
 resumable from ``--workdir``/episodes.jsonl) and writes ``results.json``, ``results.md`` and ``trajectories.png``.
@@ -18,6 +18,10 @@ true scene, rendered as its dataset renders examples, every ``--perception_every
 (``pushjax.sensing.perception``), a reading skipped when ``--perception_gate`` is given and its squared innovation
 exceeds it (``pushjax.control.closed_loop.PositionSource.gate``); its noise is estimated on one push per object simulated with seed ``--seed`` + 1
 (``pushjax.filter.tracking.simulate_pushes``), not on the evaluated episodes.
+
+``--looks`` says how many times the models' comparison has been looked at, this run included (e.g. 2 when more goals
+are added to a finished run in the same work folder): the verdict then needs Pocock's larger bound
+(``pushjax.stats.decide``).
 """
 
 import math
@@ -25,6 +29,7 @@ import math
 from absl import app, flags
 
 import experiments
+from pushjax import stats
 from pushjax.control import closed_loop, mpc, push_to_goal, report
 from pushjax.data import configs as data_configs
 from pushjax.filter import tracking
@@ -62,6 +67,9 @@ _PERCEPTION_EVERY = flags.DEFINE_integer("perception_every", 1, "Control periods
 _PERCEPTION_GATE = flags.DEFINE_float("perception_gate", None, "Skip a perception reading whose squared innovation "
                                        "(chi-square, 2 degrees of freedom) exceeds this, e.g. 13.8 (99.9 %).",
                                        lower_bound=1e-9)
+_LOOKS = flags.DEFINE_integer("looks", 1, "How many times the models' comparison has been looked at, this run "
+                              "included (pushjax.stats.SEQUENTIAL_STANDARD_ERRORS: 1-5).", lower_bound=1,
+                              upper_bound=max(stats.SEQUENTIAL_STANDARD_ERRORS))
 experiments.require_writable_folder("workdir")
 NOISE_PUSHES = 1
 """Pushes per object, simulated with seed --seed + 1, on which the perception's noise is estimated."""
@@ -150,7 +158,8 @@ def main(argv):
     try:
         results = push_to_goal.run(_WORKDIR.value, objects, _GOALS.value or scale["goals"], _MODELS.value,
                                    _PLANNERS.value or scale["planners"], _SEED.value, loop, _EFFECT_PARAMS.value,
-                                   scale["controller"], _LOOP_MODEL.value, _STATES.value, position, position_settings)
+                                   scale["controller"], _LOOP_MODEL.value, _STATES.value, position, position_settings,
+                                   _LOOKS.value)
     except push_to_goal.ModelFileError as error:
         raise app.UsageError(f"--loop_model: {error}") from None
     results["settings"]["scale"] = _SCALE.value

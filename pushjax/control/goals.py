@@ -4,7 +4,12 @@ A goal moves the object from its start pose, the origin at yaw 0, by a translati
 :data:`TRANSLATION_RANGE` in a uniform direction and a rotation uniform within ±:data:`MAX_ROTATION_DEG`, drawn
 from ``default_rng([seed, crc32(object)])``: the same seed gives every object the same goals whatever else is run.
 Success is a final TRUE pose within :data:`SUCCESS_POSITION` and :data:`SUCCESS_YAW_DEG` of the goal; success rates
-come with Wilson score intervals (:func:`wilson_interval`).
+come with Wilson score intervals (:func:`wilson_interval`). When one model pushes better than another is decided by
+the project's one rule (:func:`pushjax.stats.decide`, in :func:`pushjax.control.report.compare`): over the goals both
+were given (same object, goal and planner; the goals are the unit), the mean paired difference of the time to
+success, a failed goal counting as the episode's time limit, below zero by more than 2 standard errors of that mean
+(Pocock's larger bound when the same comparison is looked at again with more goals); above zero by as much: worse;
+in between: not decided with that many goals.
 """
 
 from __future__ import annotations
@@ -16,7 +21,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["COMPARISON_STANDARD_ERRORS", "Goal", "MAX_ROTATION_DEG", "SUCCESS_POSITION", "SUCCESS_YAW_DEG", "TRANSLATION_RANGE", "draw_goals",
+__all__ = ["Goal", "MAX_ROTATION_DEG", "SUCCESS_POSITION", "SUCCESS_YAW_DEG", "TRANSLATION_RANGE", "draw_goals",
            "succeeded", "wilson_interval"]
 
 SUCCESS_POSITION = 0.005
@@ -27,11 +32,6 @@ TRANSLATION_RANGE = (0.05, 0.20)
 """Range of the goals' translations, m."""
 MAX_ROTATION_DEG = 90.0
 """Largest goal rotation, degrees (either sense)."""
-COMPARISON_STANDARD_ERRORS = 2.0
-"""When one model pushes better than another (fixed before any comparison was run): over the goals both were given
-(same object, goal and planner; the goals are the independent unit), the mean of the paired difference of the time
-to success, a failed goal counting as the episode's time limit, is below zero by more than this many standard errors
-of that mean. Above zero by as much: worse; in between: not decided with that many goals."""
 
 
 @dataclasses.dataclass(frozen=True)

@@ -121,7 +121,7 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
         planners: Sequence[str], seed: int, loop: closed_loop.LoopConfig, effect_params: str = "",
         controller: mpc.ControllerConfig = mpc.ControllerConfig(), loop_model: str | Path | None = None,
         states: Sequence[str] = ("mocap",), position: closed_loop.PositionSource | None = None,
-        position_settings: dict | None = None) -> dict:
+        position_settings: dict | None = None, looks: int = 1) -> dict:
     """Runs every model and planner on every goal (resuming from ``workdir/episodes.jsonl``); returns the
     results of :func:`pushjax.control.report.summarise`.
 
@@ -140,6 +140,8 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
       position: the position source of the states with ``perception`` (needed when `states` has one).
       position_settings: what identifies `position` in the results' settings and the episodes' fingerprint (e.g. the
         trained model, its dataset and the noise estimate; JSON-able).
+      looks: which look at the models' comparison this run is (:func:`pushjax.stats.decide`; not part of the
+        episodes' fingerprint, so a second look resumes the first's episodes).
 
     Raises:
       ValueError: ``loop`` among `models` without `loop_model`, an unknown or repeated state source, or one with
@@ -209,4 +211,4 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
             out.write(json.dumps(row) + "\n")
             out.flush()
             rows.append(row)
-    return report.summarise(rows, settings)
+    return report.summarise(rows, settings, looks)

@@ -13,7 +13,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from pushjax import outputs, planar
+from pushjax import outputs, planar, stats
 from pushjax.control import goals
 from pushjax.geometry.objects import PUSHER_RADIUS, get_object
 
@@ -53,10 +53,10 @@ def _summary(rows: Sequence[dict]) -> dict:
     }
 
 
-def compare(rows: Sequence[dict], baseline: str, model: str, max_time: float) -> dict:
+def compare(rows: Sequence[dict], baseline: str, model: str, max_time: float, looks: int = 1) -> dict:
     """`model` against `baseline` on the goals both were given (paired by planner, object and goal; a goal's
-    differences averaged over its planners, so that the goals are the independent unit), decided by
-    :data:`pushjax.control.goals.COMPARISON_STANDARD_ERRORS`.
+    differences averaged over its planners, so that the goals are the unit of resampling), decided on the time to
+    success by :func:`pushjax.stats.decide` at the `looks`-th look at the comparison.
 
     Returns:
       ``{"model", "baseline", "goals", "time_to_success_difference_s": {"mean", "standard_error"},
@@ -82,8 +82,8 @@ def compare(rows: Sequence[dict], baseline: str, model: str, max_time: float) ->
         return {"mean": float(np.mean(difference)) if tasks else math.nan, "standard_error": error}
 
     time = paired(time_to_success)
-    margin = goals.COMPARISON_STANDARD_ERRORS * time["standard_error"]
-    verdict = "better" if time["mean"] < -margin else "worse" if time["mean"] > margin else "not decided"
+    verdict = {stats.HOLDS: "better", stats.FAILS: "worse", stats.UNDECIDED: "not decided"}[
+        stats.decide(time["mean"], time["standard_error"], looks)]
     return {"model": model, "baseline": baseline, "goals": len(tasks), "time_to_success_difference_s": time,
             "position_error_difference_mm": paired(lambda row: row["position_error_mm"]),
             "only_model_succeeded": sum(ours[key]["success"] and not theirs[key]["success"] for key in keys),
@@ -91,9 +91,10 @@ def compare(rows: Sequence[dict], baseline: str, model: str, max_time: float) ->
             "verdict": verdict}
 
 
-def summarise(rows: Sequence[dict], settings: dict) -> dict:
+def summarise(rows: Sequence[dict], settings: dict, looks: int = 1) -> dict:
     """``{"criterion", "settings", "summary": {model/planner: ...}, "per_object": {model/planner: {object: ...}},
-    "comparisons": [every other model against the first, :func:`compare`], "episodes": rows}``."""
+    "comparisons": [every other model against the first, :func:`compare` at the `looks`-th look], "episodes":
+    rows}``; the criterion records the look when it is not the first."""
     groups: dict[str, list[dict]] = {}
     for row in rows:
         groups.setdefault(f"{row['model']}/{row['planner']}", []).append(row)
@@ -102,9 +103,10 @@ def summarise(rows: Sequence[dict], settings: dict) -> dict:
         objects = sorted({row["object"] for row in members})
         per_object[name] = {obj: _summary([row for row in members if row["object"] == obj]) for obj in objects}
     models = list(dict.fromkeys(row["model"] for row in rows))
-    comparisons = [compare(rows, models[0], model, settings["loop"]["max_time"]) for model in models[1:]]
-    return {"criterion": {"position_mm": 1e3 * goals.SUCCESS_POSITION, "yaw_deg": goals.SUCCESS_YAW_DEG,
-                          "comparison_standard_errors": goals.COMPARISON_STANDARD_ERRORS},
+    comparisons = [compare(rows, models[0], model, settings["loop"]["max_time"], looks) for model in models[1:]]
+    criterion = {"position_mm": 1e3 * goals.SUCCESS_POSITION, "yaw_deg": goals.SUCCESS_YAW_DEG,
+                 "comparison_standard_errors": stats.decision_bound(looks), **({"looks": looks} if looks > 1 else {})}
+    return {"criterion": criterion,
             "settings": settings, "summary": {name: _summary(members) for name, members in groups.items()},
             "per_object": per_object, "comparisons": comparisons, "episodes": list(rows)}
 
@@ -136,7 +138,8 @@ def table(results: dict) -> str:
     if results.get("comparisons"):
         lines += ["", (f"Comparisons (paired over goals; better: the mean difference of the time to success, a failure "
                        f"counting as the time limit, below zero by more than {criterion['comparison_standard_errors']:g} "
-                       "standard errors):"), "",
+                       "standard errors" + (f", look {criterion['looks']} at the same comparison" if "looks" in criterion
+                                            else "") + "):"), "",
                   "| model − baseline | goals | time to success (s) | final position error (mm) | only model succeeded "
                   "| only baseline succeeded | verdict |", "|---|---:|---:|---:|---:|---:|---|"]
         for entry in results["comparisons"]:

@@ -23,7 +23,9 @@ hold per-sequence sums in the shape of `pushjax.train.evaluate.error_metrics` (o
 ``trans_percent`` (% of ``zero``'s error) gets the house's sequence bootstrap and seed spread
 (`pushjax.paper.statistics`); ``trans_mm`` and ``rot_deg`` are mean errors per sequence.
 
-`EXPECTATIONS` are stated before the run and decided on its numbers (`decide`), as `pushjax.paper.findings` does.
+`EXPECTATIONS` are stated before the run and decided on its numbers (`decide`) by the project's rule,
+`pushjax.stats.decide`: 2 standard errors of the paired difference, the test sequences and seeds the unit of
+resampling, one look per run (an earlier, smaller run is its own record, not a first look combined with this one).
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ import jax.numpy as jnp
 import matplotlib.pyplot as plt
 import numpy as np
 
-from pushjax import data, outputs, planar
+from pushjax import data, outputs, planar, stats
 from pushjax.data import examples as examples_lib
 from pushjax.geometry import get_object, limit_surface_ratio, outline_jax
 from pushjax.mit import files as mit_files, protocol
@@ -72,7 +74,8 @@ def horizon_labels() -> tuple[str, ...]:
 
 @dataclasses.dataclass(frozen=True)
 class Expectation:
-    """A prediction about the run, fixed before it: ``better``'s score is lower than ``worse``'s by `MARGIN` SE.
+    """A prediction about the run, fixed before it: ``better``'s score is lower than ``worse``'s
+    (`pushjax.stats.decide`).
 
     Each side is ``(model, horizon label)`` or, for a difference of two models at a horizon, ``(model_a, model_b,
     horizon label)`` (``a - b``). Scores are `pushjax.paper.statistics.SCORE` on `test_split`.
@@ -96,7 +99,7 @@ EXPECTATIONS = (
     Expectation("hybrid_beats_neural_whole", "Over the whole push at 20 mm/s hybrid beats neural.",
                 "test_20", ("hybrid", WHOLE), ("neural", WHOLE)),
 )
-"""What the run is expected to show, decided by `decide` with `pushjax.paper.findings.MARGIN`."""
+"""What the run is expected to show, decided by `decide` (`pushjax.stats.decide`)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -437,8 +440,8 @@ def _side(results: Mapping, test_split: str, side: Sequence[str]) -> statistics.
 
 
 def decide(results: Mapping) -> list[dict]:
-    """Every `EXPECTATIONS` entry decided on the run: holds / does not hold / not decidable (within `MARGIN` SE of
-    the difference) / not checked (a model or horizon missing), with the difference better - worse."""
+    """Every `EXPECTATIONS` entry decided on the run: holds / does not hold / not decided (`pushjax.stats.decide`
+    of the difference) / not checked (a model or horizon missing), with the difference better - worse."""
     decided = []
     for expectation in EXPECTATIONS:
         better, worse = (_side(results, expectation.test_split, side) for side in (expectation.better,
@@ -447,10 +450,9 @@ def decide(results: Mapping) -> list[dict]:
         if better is None or worse is None:
             decided.append({**entry, "verdict": findings.UNCHECKED, "difference": None, "se": None})
             continue
-        comparison = findings.Comparison(expectation.key, statistics.difference(better, worse), findings.MARGIN)
-        verdict = {-1: findings.HOLDS, 1: findings.FAILS, 0: findings.UNDECIDED}[comparison.outcome]
-        decided.append({**entry, "verdict": verdict, "difference": comparison.difference.value,
-                        "se": comparison.difference.se})
+        difference = statistics.difference(better, worse)
+        decided.append({**entry, "verdict": stats.decide(difference.value, difference.se),
+                        "difference": difference.value, "se": difference.se})
     return decided
 
 
@@ -484,7 +486,8 @@ def markdown(results: Mapping) -> str:
                 if any(estimate is not None for estimate in cells):
                     lines.append(f"| {model} | " + " | ".join(_format(estimate) for estimate in cells) + " |")
             lines.append("")
-    lines += ["## Expectations (stated before the run, score = mean of translation and rotation % of zero)", "",
+    lines += ["## Expectations (stated before the run, score = mean of translation and rotation % of zero, decided at "
+              f"{stats.DECISION_STANDARD_ERRORS:g} standard errors of the paired difference)", "",
               "| expectation | split | better − worse | verdict |", "|---|---|---|---|"]
     for entry in results["expectations"]:
         difference = "–" if entry["difference"] is None else f"{entry['difference']:+.1f} ± {entry['se'] or 0:.1f}"

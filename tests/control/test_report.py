@@ -60,3 +60,16 @@ def test_a_goal_planned_by_two_planners_is_one_independent_unit():
     assert result["goals"] == 4
     np.testing.assert_allclose(result["time_to_success_difference_s"]["mean"], -3.0)
     assert result["time_to_success_difference_s"]["standard_error"] == 0.0
+
+
+def test_a_second_look_needs_pococks_bound():
+    # Paired differences -0.355, -3.645, ... s: a mean of -2 s at 2.1 standard errors, beyond 2 but not 2.178.
+    rows = []
+    for index, difference in enumerate((-0.355, -3.645, -0.355, -3.645)):
+        rows.append(_row("lynch", "rect1", index, 1.0, 0.5) | {"time_s": 30.0})
+        rows.append(_row("loop", "rect1", index, 1.0, 0.5) | {"time_s": 30.0 + difference})
+    assert report.compare(rows, "lynch", "loop", max_time=60.0)["verdict"] == "better"
+    assert report.compare(rows, "lynch", "loop", max_time=60.0, looks=2)["verdict"] == "not decided"
+    results = report.summarise(rows, {"loop": {"max_time": 60.0}}, looks=2)
+    assert results["criterion"]["looks"] == 2 and results["criterion"]["comparison_standard_errors"] == 2.178
+    assert "look 2 at the same comparison" in report.table(results)
