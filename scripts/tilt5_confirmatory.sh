@@ -26,3 +26,4 @@ for SEED in 1 2 3; do
   "$PYTHON" -m experiments.push_to_goal --workdir="$WORLD/goals" --scale=full --goals=3 --models=lynch,loop \
     --loop_model="$WORLD/loop/model.json" --effects='table_tilt_deg=5' --planners=gradient,sampling --seed="$SEED"
 done
+"$PYTHON" -m experiments.pool_goals --runs="$OUT/world1/goals,$OUT/world2/goals,$OUT/world3/goals" --workdir="$OUT/pooled"

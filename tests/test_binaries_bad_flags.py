@@ -27,7 +27,8 @@ HELP_TEXT = re.compile(r"^\s+--\[?\w|^flags:|^\s+\(default: |Try --help")
 
 LIBRARIES = ("experiments, pushjax.data, pushjax.loop, pushjax.paper.findings, pushjax.paper.figures, "
              "pushjax.paper.rollouts, pushjax.paper.runner, pushjax.paper.spec, pushjax.paper.tables, "
-             "pushjax.paper.visualize, pushjax.physics.demo, pushjax.sim.dataset, pushjax.control.push_to_goal")
+             "pushjax.paper.visualize, pushjax.physics.demo, pushjax.sim.dataset, pushjax.control.push_to_goal, "
+             "pushjax.studies.adapt")
 """What the binaries import, bar the binaries themselves (each defines flags): a server imports it once and forks."""
 
 # The server: imports the libraries (not the binaries, which define the flags), then forks one child per case.
@@ -256,6 +257,11 @@ CASES = [
     ("track", ["--workdir={tmp}/track", "--seed=1", "--seeds=2,3"], "--seed"),
     ("track", ["--workdir={tmp}/track", "--perception={tmp}/missing"], "--perception"),
     ("track", ["--workdir={tmp}/track", "--perception={empty}"], "--perception"),
+    # pool_goals
+    ("pool_goals", ["--workdir={tmp}/pooled"], "--runs"),
+    ("pool_goals", ["--runs={tmp}/missing,{tmp}/missing2", "--workdir={tmp}/pooled"], "--runs"),
+    ("pool_goals", ["--runs={empty},{empty}", "--workdir={tmp}/pooled"], "--runs"),
+    ("pool_goals", ["--runs={empty}"], "--workdir"),
     # push_to_goal
     ("push_to_goal", [], "--workdir"),
     ("push_to_goal", ["--workdir={file}/goals"], "--workdir"),
@@ -276,6 +282,15 @@ CASES = [
     ("push_to_goal", ["--workdir={tmp}/goals", "--models=loop", "--loop_model={file}"], "--loop_model"),
     ("push_to_goal", ["--workdir={tmp}/goals", "--states=perception", "--perception={tmp}/missing"], "--perception"),
     ("push_to_goal", ["--workdir={tmp}/goals", "--states=perception"], "--perception"),
+    # adapt
+    ("adapt", [], "--workdir"),
+    ("adapt", ["--workdir={file}/adapt"], "--workdir"),
+    *[("adapt", ["--workdir={tmp}/adapt", f"--{flag}={value}"], f"--{flag}")
+      for flag, values in (("scale", ("huge",)), ("effect", ("wind", "")), ("worlds", ("0", "x")),
+                           ("blocks", ("0",)), ("per_block", ("-1",)), ("first_block", ("0",)),
+                           ("max_time", ("0", "nan")), ("seed", ("-1",)))
+      for value in values],
+    ("adapt", ["--workdir={tmp}/adapt", "extra"], "unexpected arguments"),
     # demo
     *[("demo", [f"--{flag}={value}"], f"--{flag}")
       for flag, values in (("mu", ("-1", "nan", "inf")), ("angle_deg", ("90", "-120", "nan")),

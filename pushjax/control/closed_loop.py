@@ -131,6 +131,10 @@ class EpisodeResult:
       estimate_times: [P] simulated seconds of the estimates (the true pose then: the row of `poses` at that time).
       readings: [R, 3] the position source's readings (t s, x m, y m; centre of mass); [0, 3] without one.
       skipped_readings: readings the gate skipped (:attr:`PositionSource.gate`).
+      recording: the whole episode at the testbed's 250 Hz clock (:class:`pushjax.sim.push.Recording`, ``params``
+        None, times from the episode's start): the pusher tip, the object pose as motion capture measured it (rows of
+        dropped samples missing), the force sensor's wrench and the true object pose; what a push file of the episode
+        holds (e.g. ``pushjax.studies.adapt``). None only for results made without the testbed.
     """
 
     final_pose: np.ndarray
@@ -148,6 +152,7 @@ class EpisodeResult:
     readings: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((0, 3)))
     estimate_times: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
     skipped_readings: int = 0
+    recording: push.Recording | None = None
 
 
 @jax.jit
@@ -232,7 +237,7 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
 
     sensor = None if position is None else models.make_position_sensor(model.shape, position.std)
     gate = math.inf if position is None or position.gate is None else position.gate
-    poses, tips, readings = [], [], []
+    poses, tips, readings, pieces = [], [], [], []
     path_length = 0.0
     periods = 0
 
@@ -244,6 +249,7 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
                                             axis=1).sum())
         first_sample = episode.samples
         piece = episode.advance(targets)
+        pieces.append(piece)
         ends = np.arange(samples_per_period - 1, len(targets), samples_per_period)
         poses.append(piece.true_object_pose[ends])
         tips.append(piece.tip_pose[ends, :3])
@@ -320,4 +326,7 @@ def run_episode(model: PushModel, config: mpc.ControllerConfig, obj: str, start,
         wall_time=time.perf_counter() - began, plans=plans, repositions=repositions, stop=stop, poses=poses,
         pusher=tips, estimates=np.asarray(estimates).reshape(-1, 3),
         readings=np.concatenate(readings) if readings else np.zeros((0, 3)),
-        estimate_times=np.asarray(estimate_times, np.float64), skipped_readings=skipped)
+        estimate_times=np.asarray(estimate_times, np.float64), skipped_readings=skipped,
+        recording=push.Recording(params=None, **{name: np.concatenate([getattr(piece, name) for piece in pieces])
+                                                  for name in ("tip_pose", "object_pose", "ft_wrench",
+                                                               "true_object_pose")}))

@@ -54,7 +54,7 @@ def _summary(rows: Sequence[dict]) -> dict:
 
 
 def compare(rows: Sequence[dict], baseline: str, model: str, max_time: float, looks: int = 1) -> dict:
-    """`model` against `baseline` on the goals both were given (paired by planner, object and goal; a goal's
+    """`model` against `baseline` on the goals both were given (paired by planner, world, object and goal; a goal's
     differences averaged over its planners, so that the goals are the unit of resampling), decided on the time to
     success by :func:`pushjax.stats.decide` at the `looks`-th look at the comparison.
 
@@ -65,7 +65,8 @@ def compare(rows: Sequence[dict], baseline: str, model: str, max_time: float, lo
       success is `max_time` (s), and the verdict is "better", "worse" or "not decided".
     """
     def by_goal(name):
-        return {(row["planner"], row["object"], row["index"]): row for row in rows if row["model"] == name}
+        return {(row["planner"], row.get("world", 0), row["object"], row["index"]): row for row in rows
+                if row["model"] == name}
 
     ours, theirs = by_goal(model), by_goal(baseline)
     keys = sorted(set(ours) & set(theirs))
@@ -109,6 +110,26 @@ def summarise(rows: Sequence[dict], settings: dict, looks: int = 1) -> dict:
     return {"criterion": criterion,
             "settings": settings, "summary": {name: _summary(members) for name, members in groups.items()},
             "per_object": per_object, "comparisons": comparisons, "episodes": list(rows)}
+
+
+def pool_worlds(runs: Sequence[dict]) -> dict:
+    """The results of push-to-goal runs in several worlds (each run's ``settings["seed"]``: its goals and testbed
+    draws) as one :func:`summarise`: every goal of every world paired across the models, the goals of all worlds the
+    unit of the comparisons; ``settings`` holds each run's under ``"runs"``.
+
+    Raises:
+      ValueError: fewer than two runs, two runs of one world, or runs of different models or time limits.
+    """
+    worlds = [run["settings"]["seed"] for run in runs]
+    if len(runs) < 2 or len(set(worlds)) != len(worlds):
+        raise ValueError(f"runs: expected runs of two or more different worlds (seeds), got seeds {worlds}")
+    models = [list(dict.fromkeys(row["model"] for row in run["episodes"])) for run in runs]
+    limits = {run["settings"]["loop"]["max_time"] for run in runs}
+    if any(names != models[0] for names in models) or len(limits) != 1:
+        raise ValueError(f"runs: expected the same models and time limit in every run, got {models} and {limits}")
+    rows = [{**row, "world": world} for run, world in zip(runs, worlds) for row in run["episodes"]]
+    return summarise(rows, {"worlds": worlds, "loop": runs[0]["settings"]["loop"],
+                            "runs": [run["settings"] for run in runs]})
 
 
 def _line(label: str, entry: dict) -> str:

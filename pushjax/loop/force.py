@@ -14,6 +14,17 @@ the vertex, where the outline has no normal. A push's estimate is the
 sliding while the contact sticks lie inside the cone, below ``mu``); pushes that never slide (their force stays inside
 the cone) or whose force sensor reads nothing have none and are counted.
 
+A push's reading has a standard error, so that the spread of the readings over pushes can be told from their
+measurement error (:mod:`pushjax.loop.variability`): the robust standard deviation of the ratio over the sliding samples
+above their median, ``(p90 - p50) / 1.2816``, and at least :data:`MIN_RELATIVE_STD` of the reading. The samples of one
+push share their error along it (the contact's place, the plate's dynamics), so the spread of one sample, not that of
+their mean, bounds how far the reading is off: on realistic testbed pushes (rect1 on pu, 20 mm/s) the readings scatter
+about the simulated coefficients by 0.24 % (equal coefficients) and 0.8 % (a spread of 0.4), the samples' spread is
+1.2-1.5 %, the standard error of a mean of stretches of :data:`SLIDE_LAG` 0.14 %; on the ideal testbed (no tracking
+noise) the readings of one coefficient scatter by 0.18 % while their samples' spread is 0.02 % (median), hence the floor.
+A reading resting on less than :data:`SLIDE_LAG` of sliding has none: such readings were off by up to 0.67 (of 0.25) on
+the realistic testbed.
+
 With this measurement the motion fit has no reason left to move the pusher friction: the loop gives the model the
 measured coefficient and drops ``pusher_friction`` from the candidates (:func:`pushjax.loop.pipeline.decide`). On clean
 testbed pushes the sensor reads the simulated 0.250 while the motion fit of ``pusher_friction`` on top of the exact
@@ -42,21 +53,30 @@ SLIDING_QUANTILE = 90
 """Percentile of a push's sliding samples' force ratios taken as its coefficient."""
 MIN_SLIDING_SAMPLES = 5
 """A push needs this many sliding samples for an estimate."""
+MIN_RELATIVE_STD = 0.005
+"""Smallest standard error of a push's reading, relative to it: readings of one coefficient scatter by up to 0.24 % over
+testbed pushes beyond their samples' spread (module docstring)."""
+_NORMAL_QUANTILE = 1.2816
+"""The standard normal's :data:`SLIDING_QUANTILE` percentile: its distance from the median in standard deviations."""
 MIN_SEQUENCES = 8
 """Push sequences with an estimate needed before the measurement replaces the nominal coefficient."""
 
 
-def sliding_friction(push: Push, obj: PushObject, noise: np.ndarray) -> float:
-    """The pusher–object friction coefficient of one push from its sliding samples, NaN when it has too few.
+def sliding_friction(push: Push, obj: PushObject, noise: np.ndarray) -> tuple[float, float]:
+    """The pusher–object friction coefficient of one push from its sliding samples and its standard error.
 
     Args:
       push: a cleaned push (object and tip poses m, rad; wrench [T, 3] fx N, fy N, torque N·m, world axes).
       obj: the pushed object.
       noise: [3] standard deviation of the object pose's tracking noise (x m, y m, yaw rad).
+
+    Returns:
+      (coefficient, standard error) (see the module docstring); (NaN, NaN) with fewer than
+      :data:`MIN_SLIDING_SAMPLES` sliding samples, a NaN standard error with fewer than :data:`SLIDE_LAG` of them.
     """
     lag = _lag(push)
     if lag == 0 or len(push.time) <= lag:
-        return math.nan
+        return math.nan, math.nan
     contact, touching = _touched(push, obj, lag)
     pose, tip = push.object, push.tip[:, :2]
     normal = np.asarray(contact.normal)
@@ -84,8 +104,11 @@ def sliding_friction(push: Push, obj: PushObject, noise: np.ndarray) -> float:
     loaded = normal_force > MIN_NORMAL_FORCE_SHARE * max(float(np.max(normal_force, initial=0.0)), 1e-9)
     used = slide & loaded
     if np.count_nonzero(used) < MIN_SLIDING_SAMPLES:
-        return math.nan
-    return float(np.percentile(tangential_force[used] / normal_force[used], SLIDING_QUANTILE))
+        return math.nan, math.nan
+    median, reading = np.percentile(tangential_force[used] / normal_force[used], [50, SLIDING_QUANTILE])
+    std = max((reading - median) / _NORMAL_QUANTILE, MIN_RELATIVE_STD * reading) if np.count_nonzero(used) >= lag \
+        else math.nan
+    return float(reading), float(std)
 
 
 def _lag(push: Push) -> int:

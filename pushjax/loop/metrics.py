@@ -10,7 +10,7 @@ import itertools
 from collections.abc import Sequence
 
 import numpy as np
-from scipy import stats
+from scipy import optimize, stats
 
 from pushjax import planar
 from pushjax.stats import resample_sequences
@@ -180,9 +180,11 @@ class NoiseFloor:
       trans_percent, rot_percent: translation and rotation error in % of the ``zero`` baseline's on the same windows.
       interval: {"trans_percent", "rot_percent": [low, high]} 95 % sequence-bootstrap interval.
       source: ``"repeats"`` (the spread of repeated pushes: tracking noise and everything that differs between
-        repetitions) or ``"tracking"`` (only the measurement noise seen in the pose streams, a lower bound, where no
-        push is repeated).
+        repetitions) or ``"tracking"`` (the measurement noise seen in the pose streams and, where given, the motion's
+        spread over the pushes' parameters, :mod:`pushjax.loop.variability`; a lower bound, where no push is repeated).
       n_windows: windows it is estimated on.
+      from_variability: {"trans_percent", "rot_percent"}: how much of the floor the pushes' parameter spread adds to
+        the tracking noise (0 from repeats, which hold it already).
     """
 
     trans_percent: float
@@ -190,6 +192,7 @@ class NoiseFloor:
     interval: dict[str, list[float]]
     source: str
     n_windows: int
+    from_variability: dict[str, float]
 
     @property
     def score(self) -> float:
@@ -204,20 +207,26 @@ MIN_REPEATED_WINDOWS = 20
 
 
 def noise_floor(target: np.ndarray, sequence: np.ndarray, push: np.ndarray, window: np.ndarray,
-                tracking_noise: np.ndarray, n_bootstrap: int = 1000, seed: int = 0) -> NoiseFloor:
+                tracking_noise: np.ndarray, n_bootstrap: int = 1000, seed: int = 0,
+                variability: np.ndarray | None = None) -> NoiseFloor:
     """The error of an oracle that predicts each window's expected motion, estimated from the data.
 
     With repeated pushes (windows of the same index in several pushes of one sequence), the oracle's error on a
     window is its distance from the other repetitions' mean, times ``sqrt((n - 1) / n)`` (which turns the spread
     about a leave-one-out mean into that about the true mean, for Gaussian spread). Without, the targets are
-    differences of two poses each with white tracking noise ``s`` ([N, 3] ``tracking_noise``): the oracle's mean
-    error is ``s sqrt(pi)`` in translation (Rayleigh with ``sqrt(2) s`` per axis) and ``2 s / sqrt(pi)`` in rotation.
+    differences of two poses each with white tracking noise ``s`` ([N, 3] ``tracking_noise``), and the motion varies by
+    ``v`` ([N, 3] ``variability``) with the parameters that differ from push to push, which the oracle does not know
+    for the push at hand: with per-axis variances ``2 s^2 + v^2`` (translation: their mean over the two axes) the
+    oracle's mean error is Rayleigh's ``sqrt(pi / 2)`` times the standard deviation in translation and ``sqrt(2 / pi)``
+    times it in rotation (``s sqrt(pi)`` and ``2 s / sqrt(pi)`` without variability).
 
     Args:
       target: [N, 3] measured motions (m, m, rad).
       sequence, push, window: [N] the windows' push sequence, push and index in the push.
       tracking_noise: [N, 3] measurement noise (m, m, rad).
       n_bootstrap, seed: the sequence bootstrap of the interval.
+      variability: [N, 3] standard deviation of each window's motion over the pushes' parameter spread, object axes
+        (m, m, rad; :func:`pushjax.loop.variability.window_spread`), or None.
     """
     target = np.asarray(target, np.float64)
     groups = np.unique(np.stack([sequence, window], axis=1), axis=0, return_inverse=True)[1].reshape(-1)
@@ -229,21 +238,28 @@ def noise_floor(target: np.ndarray, sequence: np.ndarray, push: np.ndarray, wind
         n = sizes[:, None].astype(np.float64)
         others = (totals - target) / np.maximum(n - 1, 1)
         deviation = (target - others) * np.sqrt(np.maximum(n - 1, 1) / n)
-        trans = np.linalg.norm(deviation[:, :2], axis=1)
-        rot = np.abs(deviation[:, 2])
+        errors = [(np.linalg.norm(deviation[:, :2], axis=1), np.abs(deviation[:, 2]))]
     else:
         source, keep = "tracking", np.ones(len(target), bool)
         noise = np.asarray(tracking_noise, np.float64)
-        trans = np.sqrt(np.pi) * np.sqrt(0.5 * (noise[:, 0] ** 2 + noise[:, 1] ** 2))
-        rot = 2.0 * noise[:, 2] / np.sqrt(np.pi)
-    oracle = WindowErrors(translation_mm=1e3 * trans[keep], rotation_deg=np.degrees(rot[keep]),
-                          zero_translation_mm=1e3 * np.linalg.norm(target[keep, :2], axis=1),
-                          zero_rotation_deg=np.degrees(np.abs(target[keep, 2])), sequence=np.asarray(sequence)[keep])
-    summary = summarize(oracle)
+        errors = []
+        for spread in [np.zeros_like(noise)] + ([] if variability is None else [np.asarray(variability, np.float64)]):
+            variance = 2.0 * noise ** 2 + spread ** 2
+            errors.append((np.sqrt(np.pi / 2) * np.sqrt(0.5 * (variance[:, 0] + variance[:, 1])),
+                           np.sqrt(2 / np.pi) * np.sqrt(variance[:, 2])))
+
+    def oracle_errors(trans, rot):
+        return WindowErrors(translation_mm=1e3 * trans[keep], rotation_deg=np.degrees(rot[keep]),
+                            zero_translation_mm=1e3 * np.linalg.norm(target[keep, :2], axis=1),
+                            zero_rotation_deg=np.degrees(np.abs(target[keep, 2])), sequence=np.asarray(sequence)[keep])
+
+    oracle = oracle_errors(*errors[-1])
+    floor, without = summarize(oracle), summarize(oracle_errors(*errors[0]))
     interval = bootstrap_interval(oracle, n_bootstrap, seed)
-    return NoiseFloor(trans_percent=summary["trans_percent"], rot_percent=summary["rot_percent"],
+    return NoiseFloor(trans_percent=floor["trans_percent"], rot_percent=floor["rot_percent"],
                       interval={key: interval[key] for key in ("trans_percent", "rot_percent")}, source=source,
-                      n_windows=int(keep.sum()))
+                      n_windows=int(keep.sum()),
+                      from_variability={key: floor[key] - without[key] for key in ("trans_percent", "rot_percent")})
 
 
 @dataclasses.dataclass(frozen=True)
@@ -255,6 +271,9 @@ class RandomEffects:
       q: Cochran's Q of the groups about ``fixed_mean``.
       p_value: Q against chi-square with groups - 1 degrees of freedom (small: the groups differ beyond their errors).
       tau: the between-group standard deviation.
+      tau_interval: (low, high) its Q-profile confidence interval (Viechtbauer 2007): the ``tau`` whose generalised Q,
+        ``sum (value - mean(tau))^2 / (std^2 + tau^2)``, equals the chi-square quantiles with groups - 1 degrees of
+        freedom; a bound is 0 where Q at ``tau = 0`` is below its quantile (the errors alone explain the groups' spread).
       mean, mean_std: the shared value (weights ``1 / (std^2 + tau^2)``) and its standard error.
       shrunk: [G] each group's value shrunk towards ``mean`` by ``tau^2 / (tau^2 + std^2)`` (empirical Bayes).
       shrunk_std: [G] their standard errors: the share of each group's own error that shrinkage keeps, plus the
@@ -265,14 +284,16 @@ class RandomEffects:
     q: float
     p_value: float
     tau: float
+    tau_interval: tuple[float, float]
     mean: float
     mean_std: float
     shrunk: np.ndarray
     shrunk_std: np.ndarray
 
 
-def random_effects(value: np.ndarray, std: np.ndarray) -> RandomEffects:
-    """Pools [G] group estimates with [G] standard errors (all > 0, G >= 2); see :class:`RandomEffects`."""
+def random_effects(value: np.ndarray, std: np.ndarray, level: float = 0.95) -> RandomEffects:
+    """Pools [G] group estimates with [G] standard errors (all > 0, G >= 2); see :class:`RandomEffects` (``level``: of
+    ``tau_interval``)."""
     value, variance = np.asarray(value, np.float64), np.asarray(std, np.float64) ** 2
     weight = 1.0 / variance
     fixed_mean = float(np.sum(weight * value) / np.sum(weight))
@@ -282,9 +303,29 @@ def random_effects(value: np.ndarray, std: np.ndarray) -> RandomEffects:
     mean = float(np.sum(random_weight * value) / np.sum(random_weight))
     keep = tau_squared / (tau_squared + variance)
     return RandomEffects(fixed_mean=fixed_mean, q=q, p_value=float(stats.chi2.sf(q, len(value) - 1)),
-                         tau=float(np.sqrt(tau_squared)), mean=mean, mean_std=float(np.sqrt(1.0 / np.sum(random_weight))),
+                         tau=float(np.sqrt(tau_squared)), tau_interval=_tau_interval(value, variance, level), mean=mean, mean_std=float(np.sqrt(1.0 / np.sum(random_weight))),
                          shrunk=mean + keep * (value - mean),
                          shrunk_std=np.sqrt(keep * variance + (1.0 - keep) ** 2 / np.sum(random_weight)))
+
+
+def _tau_interval(value: np.ndarray, variance: np.ndarray, level: float) -> tuple[float, float]:
+    """The Q-profile interval of the between-group standard deviation (see :class:`RandomEffects`)."""
+
+    def generalised_q(tau_squared):
+        weight = 1.0 / (variance + tau_squared)
+        mean = np.sum(weight * value) / np.sum(weight)
+        return float(np.sum(weight * (value - mean) ** 2))
+
+    # Q falls from Q(0) towards 0 as tau^2 grows; by tau^2 = 1e4 times the values' own variance plus the errors' it is
+    # below every quantile that matters.
+    largest = 1e4 * (np.var(value) + np.max(variance)) + 1e-300
+    bounds = []
+    for quantile in (stats.chi2.ppf(0.5 + level / 2, len(value) - 1), stats.chi2.ppf(0.5 - level / 2, len(value) - 1)):
+        if generalised_q(0.0) <= quantile:
+            bounds.append(0.0)
+        else:
+            bounds.append(float(np.sqrt(optimize.brentq(lambda t: generalised_q(t) - quantile, 0.0, largest))))
+    return bounds[0], bounds[1]
 
 
 COVERAGE_LEVELS = (0.68, 0.95)

@@ -25,6 +25,7 @@ from pushjax.loop import report as report_lib
 from pushjax.loop import select as select_lib
 from pushjax.loop import shape as shape_lib
 from pushjax.loop import splits as splits_lib
+from pushjax.loop import variability as variability_lib
 from pushjax.loop.windows import NOMINAL_PUSHER_FRICTION, Examples, build_examples
 from pushjax.mit.files import iter_pushes
 from pushjax.physics import model_file
@@ -83,10 +84,12 @@ class Decision:
       diagnosis_before: the plain model's residual on the pool against the variables.
       diagnosis_after: the selected model's out-of-fold residual on the selection windows.
       noise: [3] standard deviation of that residual along the object's axes and of the rotation (m, m, rad).
+      variability: {parameter: its spread over the pool's pushes} (:func:`pushjax.loop.variability.measure`).
       selected_multipliers, fallback_multipliers: [L, 3] split-conformal half-widths of the
         :data:`pushjax.loop.metrics.COVERAGE_LEVELS` intervals (:func:`pushjax.loop.metrics.interval_multipliers`), in
-        units of ``noise`` for the selected model and of the error term's own standard deviation for the fallback,
-        from their out-of-fold residuals on the selection windows.
+        units of the selected model's predictive standard deviation (``noise`` and each window's motion spread over the
+        pushes' parameters in quadrature, :func:`pushjax.loop.variability.window_spread`) and of the error term's own
+        standard deviation for the fallback, from their out-of-fold residuals on the selection windows.
       alpha: the level of the fallback's test.
     """
 
@@ -99,6 +102,7 @@ class Decision:
     diagnosis_before: list[diagnose_lib.Dependence]
     diagnosis_after: list[diagnose_lib.Dependence]
     noise: np.ndarray
+    variability: dict[str, variability_lib.Variability]
     selected_multipliers: np.ndarray
     fallback_multipliers: np.ndarray
     alpha: float
@@ -155,12 +159,17 @@ def decide(examples: Examples, settings: LoopSettings = LoopSettings(), seed: in
     local = metrics.standardised_residuals(final.prediction, np.ones_like(final.prediction), selection_windows.target,
                                            yaw)
     noise = np.sqrt(np.mean(local ** 2, axis=0))
+    variability = variability_lib.measure(split.pool)
+    # The predictive standard deviation: the fitted noise and the window's motion spread over the pushes' parameters
+    # in quadrature, so that the intervals widen where a push's own parameters matter (a sliding contact).
+    selected_std = np.sqrt(noise ** 2 + variability_lib.window_spread(selection.model, selection_windows,
+                                                                       variability) ** 2)
     fallback_z = metrics.standardised_residuals(np.concatenate(means), np.concatenate(stds), selection_windows.target,
                                                 yaw)
     return Decision(split=split, force=force, selection=selection, fallback_gain=float(gains.sum() / final.score),
                     fallback_p_value=float(metrics.sign_flip_pvalues(gains, seed=seed)[0]), variables=variables,
-                    diagnosis_before=before, diagnosis_after=after, noise=noise,
-                    selected_multipliers=metrics.interval_multipliers(local / noise),
+                    diagnosis_before=before, diagnosis_after=after, noise=noise, variability=variability,
+                    selected_multipliers=metrics.interval_multipliers(local / selected_std),
                     fallback_multipliers=metrics.interval_multipliers(fallback_z),
                     alpha=settings.alpha)
 
@@ -260,7 +269,8 @@ def close_loop(
                 metrics.summarize(errors), interval=metrics.bootstrap_interval(errors, settings.n_bootstrap, seed))
 
         yaw = np.asarray(test.inputs.object_yaw, np.float64)
-        noise = np.broadcast_to(decision.noise, model_test.shape)
+        spread = variability_lib.window_spread(model, test, decision.variability)
+        selected_std = np.sqrt(decision.noise ** 2 + spread ** 2)
         report = report_lib.LoopReport(
             n_pushes={**split.n_pushes(), "skipped": int(n_skipped)},
             baseline=measured(plain_test),
@@ -272,7 +282,8 @@ def close_loop(
             alternatives=selection.alternatives,
             after=measured(model_test),
             noise_floor=metrics.noise_floor(test.target, test.sequence, test.push, test.window, test.tracking_noise,
-                                            settings.n_bootstrap, seed),
+                                            settings.n_bootstrap, seed, variability=spread),
+            variability=decision.variability,
             pusher_friction=report_lib.PusherFriction(
                 nominal=settings.pusher_friction, force_sensor=decision.force,
                 from_force_sensor=settings.measure_pusher_friction and decision.force.measured,
@@ -280,7 +291,8 @@ def close_loop(
             fallback=measured(fallback_mean),
             remaining=decision.remaining,
             uncertainty=report_lib.Uncertainty(
-                selected=metrics.predictive_scores(model_test, noise, test.target, yaw, decision.selected_multipliers),
+                selected=metrics.predictive_scores(model_test, selected_std, test.target, yaw,
+                                                   decision.selected_multipliers),
                 noise=decision.noise,
                 fallback=metrics.predictive_scores(fallback_mean, fallback_std, test.target, yaw,
                                                    decision.fallback_multipliers)),

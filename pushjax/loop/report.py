@@ -17,6 +17,7 @@ from pushjax.loop import hierarchy
 from pushjax.loop import shape as shape_lib
 from pushjax.loop import metrics
 from pushjax.loop import select as select_lib
+from pushjax.loop import variability as variability_lib
 from pushjax.loop.windows import CATEGORICAL, VARIABLES, Examples
 from pushjax.physics import model_file
 
@@ -95,7 +96,8 @@ class Uncertainty:
     """Scores of the predictive distributions on the test split (see :func:`pushjax.loop.metrics.predictive_scores`).
 
     Attributes:
-      selected: scores of the selected model with its fitted noise.
+      selected: scores of the selected model with its fitted noise and each window's motion spread over the pushes'
+        parameters (:func:`pushjax.loop.variability.window_spread`) in quadrature.
       noise: [3] that noise: standard deviation along the object's axes and of the rotation (m, m, rad).
       fallback: scores of the learned error term's mean and variance.
     """
@@ -119,7 +121,9 @@ class LoopReport:
         (they passed the same tests with a smaller gain that the selected one's does not exceed beyond noise); a
         rival explains the data as well, so the selected effect's physics is not decided between them.
       after: the selected model's test errors.
-      noise_floor: the test split's noise floor.
+      noise_floor: the test split's noise floor: tracking noise and the motion's spread over the pushes' parameters
+        (or the spread of repeated pushes).
+      variability: {parameter: its spread over the pool's pushes} (:mod:`pushjax.loop.variability`).
       pusher_friction: the pusher–object friction coefficient the models used.
       fallback: the selected model's plus the learned error term's test errors.
       remaining: the variables the selected model's residual still depends on beyond noise (select split).
@@ -138,6 +142,7 @@ class LoopReport:
     alternatives: dict[str, dict[str, float]]
     after: HeldOutErrors
     noise_floor: metrics.NoiseFloor
+    variability: dict[str, variability_lib.Variability]
     pusher_friction: PusherFriction
     fallback: HeldOutErrors
     remaining: list[diagnose_lib.Dependence]
@@ -152,8 +157,17 @@ class LoopReport:
 
     @property
     def explained(self) -> bool:
-        """Whether the selected model's test error is within the noise floor's interval."""
+        """Whether the selected model's test error is within the noise floor's interval (tracking noise and the
+        pushes' parameter spread)."""
         return all(getattr(self.after, key) <= self.noise_floor.interval[key][1] for key in self.above_floor)
+
+    @property
+    def variability_share(self) -> float:
+        """The share of the selected model's test error above the tracking noise that the pushes' parameter spread
+        accounts for (at most 1; 0 where the error is not above the tracking noise)."""
+        spread = sum(self.noise_floor.from_variability.values())
+        above_tracking = self.after.combined - (self.noise_floor.score - spread)
+        return float(min(1.0, spread / above_tracking)) if above_tracking > 0 else 0.0
 
     def as_dict(self) -> dict:
         """The content of ``report.json``."""
@@ -166,6 +180,7 @@ class LoopReport:
             "alternatives": self.alternatives,
             "after": dataclasses.asdict(self.after),
             "noise_floor": self.noise_floor.as_dict(),
+            "variability": {name: values.as_dict() for name, values in self.variability.items()},
             "pusher_friction": {**dataclasses.asdict(self.pusher_friction),
                                 "force_sensor": self.pusher_friction.force_sensor.as_dict()},
             "explained": self.explained,
@@ -175,7 +190,8 @@ class LoopReport:
                 "regimes": [[low, high if math.isfinite(high) else None]
                             for low, high in self.limit_surface_shape.regimes]},
             "fallback": dataclasses.asdict(self.fallback),
-            "remaining": {"above_floor": self.above_floor, "variables": _strengths(self.remaining)},
+            "remaining": {"above_floor": self.above_floor, "variability_share": self.variability_share,
+                          "variables": _strengths(self.remaining)},
             "uncertainty": {
                 "selected": {**self.uncertainty.selected,
                              "noise": {"x_mm": 1e3 * float(self.uncertainty.noise[0]),
@@ -400,6 +416,22 @@ def _combined_rim(motion: dict, force: dict, alpha: float = 0.05) -> str:
             "times narrower than the motion's alone.")
 
 
+def _variability_lines(variability: dict[str, variability_lib.Variability]) -> list[str]:
+    """A table of the parameters' spread over the pushes, or nothing."""
+    if not variability:
+        return []
+    lines = ["", "## Push-to-push variability", "",
+             "Parameters read on each pool push, pooled with the pushes as random-effects groups: the spread between "
+             "pushes (relative standard deviation, 95 % Q-profile interval) apart from the readings' measurement noise. "
+             "The selected model's intervals widen by it and the noise floor holds it.", "",
+             "| parameter | mean | relative sd (95 % interval) | measurement noise (relative) | pushes | source |",
+             "|---|---|---|---|---|---|"]
+    lines += [f"| {name} | {values.mean:.4g} ± {values.mean_std:.2g} | {values.relative_sd:.3f} ({values.interval[0]:.3f}–"
+              f"{values.interval[1]:.3f}) | {values.measurement_relative_sd:.3f} | {values.n_pushes} | {values.source} |"
+              for name, values in variability.items()]
+    return lines
+
+
 def _alternatives_lines(alternatives: dict[str, dict[str, float]]) -> list[str]:
     """A paragraph naming the selected effects the data cannot tell from others, or nothing."""
     if not alternatives:
@@ -484,6 +516,7 @@ def markdown(result: LoopResult) -> str:
                  "a measured parameter is no knob." if friction.from_force_sensor else
                  f"The models use the nominal {friction.used:g}"
                  + (" (too few sequences slid for a measurement)." if not sensor.measured else "."))]
+    lines += _variability_lines(report.variability)
     select_floor = details.select_noise_floor
     lines += ["", "## Forward selection", "",
               f"Every candidate of a round is tested: its gain on the select split must be beyond noise (one-sided "
@@ -547,6 +580,10 @@ def markdown(result: LoopResult) -> str:
         f"{floor.trans_percent:.1f} % ({floor.interval['trans_percent'][0]:.1f}–{floor.interval['trans_percent'][1]:.1f}),"
         f" rotation {floor.rot_percent:.1f} % ({floor.interval['rot_percent'][0]:.1f}–"
         f"{floor.interval['rot_percent'][1]:.1f}).")
+    if report.variability:
+        lines[-1] += (f" The push-to-push variability adds {floor.from_variability['trans_percent']:.1f} and "
+                      f"{floor.from_variability['rot_percent']:.1f} points of it to the tracking noise: "
+                      f"{report.variability_share:.0%} of the selected model's error above the tracking noise.")
     lines.append("")
     if report.explained:
         lines.append("**Explained:** the selected model's test error is within the noise floor's interval.")

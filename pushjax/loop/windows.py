@@ -78,6 +78,7 @@ class Examples:
         estimated from the pose stream (:func:`tracking_noise`).
       push_friction: [N] the pusher–object friction coefficient that the force sensor read while the window's push
         slid (:func:`pushjax.loop.force.sliding_friction`; NaN where it never slid or read no force).
+      push_friction_std: [N] that reading's standard error (NaN where the push slid too briefly for one).
       wrench: [N, 3] the mean wrench the pusher applied over the window: force along the object's axes (N) and moment
         about its centre of mass (N·m) (:func:`pushjax.loop.force.window_wrenches`; NaN where it never touched).
       variables: {name: [N] values} of the candidate explanatory variables (see :data:`VARIABLES`).
@@ -91,6 +92,7 @@ class Examples:
     window: np.ndarray
     tracking_noise: np.ndarray
     push_friction: np.ndarray
+    push_friction_std: np.ndarray
     wrench: np.ndarray
     variables: dict[str, np.ndarray]
     sequence_names: tuple[str, ...]
@@ -111,7 +113,8 @@ class Examples:
         return Examples(
             inputs=jax.tree.map(lambda values: np.asarray(values)[mask], self.inputs),
             target=self.target[mask], sequence=self.sequence[mask], push=self.push[mask], window=self.window[mask],
-            tracking_noise=self.tracking_noise[mask], push_friction=self.push_friction[mask], wrench=self.wrench[mask],
+            tracking_noise=self.tracking_noise[mask], push_friction=self.push_friction[mask],
+            push_friction_std=self.push_friction_std[mask], wrench=self.wrench[mask],
             variables={name: values[mask] for name, values in self.variables.items()}, sequence_names=self.sequence_names,
         )
 
@@ -134,8 +137,13 @@ class BuildSummary:
 
 
 def _sequence_key(push: Push) -> str:
+    """The push sequence of `push`: its file-name fields bar the repetition (the MIT protocol repeats a straight
+    push from one start pose at one velocity), and, for a file in a folder of its own below its object's folder
+    (``<surface>/<object>/<sequence>/...h5``), that folder: a push whose pusher path is not the protocol's, e.g. one
+    controller episode (``pushjax.studies.adapt``), is a sequence of its own whatever its file-name fields."""
     params = dataclasses.replace(push.params, repetition=None)
-    return (f"{params.surface}/{params.shape}/a={params.acceleration:g}/v={params.velocity:g}/i={params.side}"
+    folder = "" if push.path.parent.name == params.shape else f"{push.path.parent.name}/"
+    return (f"{params.surface}/{params.shape}/{folder}a={params.acceleration:g}/v={params.velocity:g}/i={params.side}"
             f"/s={params.point:.3f}/t={params.angle:.3f}")
 
 
@@ -229,6 +237,7 @@ def build_examples(
         stop_time = push.time[stop]
         noise = tracking_noise(push.object)
         speed_until = np.minimum(ends, stop)
+        friction, friction_std = sliding_friction(push, get_object(push.params.shape), noise)
         rows[push.params.shape].append(dict(
             pose0=push.object[starts], pose1=push.object[ends], tip0=push.tip[starts, :2],
             motion=push.tip[ends, :2] - push.tip[starts, :2],
@@ -239,7 +248,8 @@ def build_examples(
             push=np.full(len(starts), n_pushes - 1),
             window=np.arange(len(starts)),
             tracking_noise=np.broadcast_to(noise, (len(starts), 3)),
-            push_friction=np.full(len(starts), sliding_friction(push, get_object(push.params.shape), noise)),
+            push_friction=np.full(len(starts), friction),
+            push_friction_std=np.full(len(starts), friction_std),
             wrench=window_wrenches(push, get_object(push.params.shape), starts, ends),
             params=push.params,
         ))
@@ -260,7 +270,8 @@ def build_examples(
     inputs = PushInputs(**{field.name: merged[field.name] for field in dataclasses.fields(PushInputs)})
     examples = Examples(inputs=inputs, target=merged["target"], sequence=merged["sequence"], push=merged["push"],
                         window=merged["window"], tracking_noise=merged["tracking_noise"],
-                        push_friction=merged["push_friction"], wrench=merged["wrench"], variables=variables,
+                        push_friction=merged["push_friction"], push_friction_std=merged["push_friction_std"],
+                        wrench=merged["wrench"], variables=variables,
                         sequence_names=tuple(sequence_index))
     return examples, BuildSummary(n_pushes=n_pushes, skipped=dict(skipped))
 
@@ -316,7 +327,7 @@ def _annotate_object(name: str, rows: list[dict], pusher_friction: float) -> dic
         support_feet=np.broadcast_to(support_feet_loads, (count, len(support_feet_loads))),
         target=np.column_stack([com1 - com0, pose1[:, 2] - pose0[:, 2]]),
         sequence=data["sequence"], push=data["push"], window=data["window"], tracking_noise=data["tracking_noise"],
-        push_friction=data["push_friction"], wrench=data["wrench"],
+        push_friction=data["push_friction"], push_friction_std=data["push_friction_std"], wrench=data["wrench"],
         variables=variables,
     )
 

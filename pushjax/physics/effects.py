@@ -83,6 +83,17 @@ composed. The effects (the keys of :data:`EFFECTS`, applied in this order whatev
     ``E|r|^2 = (9/8) l^2``). One mechanism, so the shift and ``l`` move together (unlike ``cof_offset`` plus
     ``friction_ratio``).
 
+``leading_edge``  {"lever": [] m}
+    The pusher presses on the object's side at a height ``h`` above the table, while the table's friction acts at the
+    base: the moment of the pushing force tips the support pressure towards the leading edge. Moment balance about the
+    base (quasi-static, vertical forces from gravity and the table only) moves the centre of pressure by
+    ``h F / (m g) = mu_table h f``, with ``f`` the pusher's force over the maximal friction force ``mu_table m g``,
+    world axes; ``lever = mu_table h`` (``mu_table t / 2`` for a plate of thickness ``t`` pushed at half its height,
+    e.g. 2.2 mm for rect1 on polyurethane), the shift of a plate the pusher slides along (``|f| = 1``). ``f`` is the
+    force of Lynch's ellipsoid on the state the other effects leave (:func:`leading_edge_shift`: along ``P u`` while
+    the contact sticks, the friction cone's boundary while it slips), so the shift is first order in ``lever``.
+    The centre of friction moves by the shift, the contact geometry stays (as ``cof_offset``, but the shift follows
+    each push's force). A negative ``lever`` moves the load backwards, which no pusher's height gives.
 ``limit_surface``  {"rim": [] -, "feet": [] share in [0, 1]}
     The exact limit surface of the support instead of Lynch's ellipsoid (which matches the exact one only at
     pure translation and pure rotation): the quasi-static, maximal-dissipation twist of the support described by
@@ -124,6 +135,7 @@ __all__ = [
     "compatible",
     "compose",
     "init_params",
+    "leading_edge_shift",
     "limit_surface_predict",
     "needs_support",
     "physical_params",
@@ -446,6 +458,47 @@ def _pressure_gradient_physical(params):
             "offset_over_l": jnp.hypot(params["offset"][..., 0], params["offset"][..., 1])}
 
 
+def leading_edge_shift(lever: jax.Array, contact: jax.Array, normal: jax.Array, action: jax.Array, l: jax.Array,
+                       mu: jax.Array, s: jax.Array = 1.0) -> jax.Array:
+    """How far the pushing force tips the support pressure towards the leading edge (see ``leading_edge``).
+
+    Args:
+      lever: [...] the table's friction coefficient times the pushing contact's height above the table, m.
+      contact: [..., 2] contact point relative to the centre of friction, world axes, m.
+      normal: [..., 2] inward surface normal (any length, 0 = no contact).
+      action: [..., 2] pusher motion, m.
+      l: [...] limit-surface ratio, m (> 0).
+      mu: [...] pusher-object friction coefficient (>= 0).
+      s: [...] contact indicator in [0, 1], scales the force.
+
+    Returns:
+      [..., 2] the centre of pressure's shift, world axes, m: ``lever`` times the pusher's force over the maximal
+      friction force under Lynch's ellipsoid (on the limit surface, ``|f|^2 + (c x f)^2 / l^2 = 1``); zero where the
+      pusher does not push.
+    """
+    cx, cy = contact[..., 0], contact[..., 1]
+    nx, ny = normal[..., 0], normal[..., 1]
+    ux, uy = action[..., 0], action[..., 1]
+    l2 = l * l
+    # The sticking force P u = l^2 u + (c . u) c, or the friction cone's boundary on its side when it leaves the cone.
+    c_dot_u = cx * ux + cy * uy
+    px, py = l2 * ux + c_dot_u * cx, l2 * uy + c_dot_u * cy
+    cross = nx * py - ny * px
+    inside = jnp.abs(cross) <= mu * (nx * px + ny * py)
+    side_mu = jnp.where(cross > 0, mu, -mu)
+    fx, fy = jnp.where(inside, px, nx - side_mu * ny), jnp.where(inside, py, ny + side_mu * nx)
+    torque = cx * fy - cy * fx
+    size = fx * fx + fy * fy + torque * torque / l2
+    pushing = (ux * nx + uy * ny > 0) & (size > 0)
+    scale = jnp.where(pushing, s / jnp.sqrt(jnp.where(pushing, size, 1.0)), 0.0)
+    return jnp.asarray(lever)[..., None] * jnp.stack([fx * scale, fy * scale], axis=-1)
+
+
+def _leading_edge_modify(params, state, inputs):
+    shift = leading_edge_shift(params["lever"], state.contact, state.normal, state.action, state.l, state.mu, state.s)
+    return state.replace(contact=state.contact - shift, centre=state.centre + shift)
+
+
 def _inertia_project(params):
     return {"inverse_deceleration": jnp.maximum(params["inverse_deceleration"], 0.0)}
 
@@ -549,6 +602,8 @@ EFFECTS: dict[str, Effect] = {
                project=_friction_speed_project, physical=_friction_speed_physical),
         Effect(name="pressure_gradient", init=_zeros(offset=(2,)), typical={"offset": 0.01},
                modify=_pressure_gradient_modify, physical=_pressure_gradient_physical, per_object=True),
+        Effect(name="leading_edge", init=_zeros(lever=()), typical={"lever": 0.003}, modify=_leading_edge_modify,
+               physical=lambda p: {"lever_mm": 1e3 * p["lever"]}),
         Effect(name="limit_surface", init=_zeros(rim=(), feet=()), typical={"rim": 1.0, "feet": 0.3},
                physical=_limit_surface_physical, project=_limit_surface_project, solve=_limit_surface_solve, excludes=("friction_ratio", "pressure_gradient", "anisotropic_friction"),
                per_object=True),

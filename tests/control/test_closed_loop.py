@@ -54,6 +54,14 @@ def test_the_same_seed_gives_the_same_run(episodes):
     first, second = episodes
     np.testing.assert_array_equal(first.poses, second.poses)
     np.testing.assert_array_equal(first.estimates, second.estimates)
+    # The whole episode at 250 Hz, as a push file holds it: every stream from the first sample to the last pose.
+    recording = first.recording
+    samples = round(first.time / 0.004)
+    np.testing.assert_allclose(recording.tip_pose[:, 0], np.arange(1, samples + 1) * 0.004)
+    assert len(recording.ft_wrench) == len(recording.true_object_pose) == samples
+    assert 0.9 * samples < len(recording.object_pose) <= samples  # motion capture drops a few
+    np.testing.assert_array_equal(recording.true_object_pose[-1], first.poses[-1])
+    np.testing.assert_array_equal(recording.object_pose, second.recording.object_pose)
 
 
 PERCEPTION_MODEL = Path(__file__).resolve().parents[2] / "results" / "track_perception" / "model"

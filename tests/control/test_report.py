@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 
 from pushjax.control import goals, report
 
@@ -73,3 +74,22 @@ def test_a_second_look_needs_pococks_bound():
     results = report.summarise(rows, {"loop": {"max_time": 60.0}}, looks=2)
     assert results["criterion"]["looks"] == 2 and results["criterion"]["comparison_standard_errors"] == 2.178
     assert "look 2 at the same comparison" in report.table(results)
+
+
+def test_runs_in_several_worlds_pool_their_goals_without_pairing_across_worlds():
+    def run(seed, loop_times):
+        episodes = [_row(model, "rect1", index, 1.0, 0.5) | {"time_s": time}
+                    for index, loop_time in enumerate(loop_times)
+                    for model, time in (("lynch", 30.0), ("loop", loop_time))]
+        return {"settings": {"seed": seed, "loop": {"max_time": 60.0}}, "episodes": episodes}
+
+    # Goal 0 of world 1 and goal 0 of world 2 are different goals: 4 goals in all, not 2 paired twice.
+    pooled = report.pool_worlds([run(1, [28.0, 27.0]), run(2, [26.0, 29.0])])
+    (comparison,) = pooled["comparisons"]
+    assert comparison["goals"] == 4 and pooled["settings"]["worlds"] == [1, 2]
+    np.testing.assert_allclose(comparison["time_to_success_difference_s"]["mean"], -2.5)
+    assert comparison["verdict"] == "better"
+    assert pooled["summary"]["loop/gradient"]["goals"] == 4
+    for runs in ([run(1, [28.0])], [run(1, [28.0]), run(1, [27.0])]):
+        with pytest.raises(ValueError, match="two or more different worlds"):
+            report.pool_worlds(runs)

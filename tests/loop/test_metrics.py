@@ -1,6 +1,7 @@
 """Tests of the noise model of the loop's decisions: the sign-flip test and predictive scores."""
 
 import numpy as np
+import pytest
 
 from pushjax.loop import metrics
 
@@ -113,3 +114,15 @@ def test_noise_floor_without_repeats_comes_from_the_tracking_noise():
     assert floor.source == "tracking"
     assert abs(floor.trans_percent - oracle["trans_percent"]) < 0.1 * oracle["trans_percent"]
     assert abs(floor.rot_percent - oracle["rot_percent"]) < 0.1 * oracle["rot_percent"]
+
+
+@pytest.mark.parametrize("tau", [0.0, 0.5])
+def test_random_effects_spread_interval_covers_the_true_spread(tau):
+    rng = np.random.default_rng(0)
+    std = rng.uniform(0.2, 0.4, 30)
+    intervals = np.array([metrics.random_effects(rng.normal(1.0, tau, 30) + rng.normal(0, std), std).tau_interval
+                          for _ in range(300)])
+    covered = np.mean((intervals[:, 0] <= tau) & (tau <= intervals[:, 1]))
+    assert 0.92 < covered <= 0.98 if tau else covered >= 0.95
+    if not tau:  # groups that differ by their errors alone: the interval reaches zero
+        assert np.mean(intervals[:, 0] == 0) >= 0.95

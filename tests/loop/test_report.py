@@ -5,7 +5,8 @@ markdown code from before the results were typed (which read the two JSON files'
 had the keys, in order, of the files that code's loop wrote: the typed results changed no key and no byte. Since then
 the files gained the per-group values (``per_group``), the calibrated coverages and the limit surface's shape from the
 force sensor (``limit_surface_shape``), the effects the data cannot tell a selected one from (``alternatives``),
-and nothing else.
+the push-to-push variability (``variability``, the noise floor's ``from_variability`` and ``remaining``'s
+``variability_share``), and nothing else.
 """
 
 import dataclasses
@@ -21,6 +22,7 @@ from pushjax.loop.force import ForceFriction
 from pushjax.loop.hierarchy import GroupValues
 from pushjax.loop.metrics import NoiseFloor
 from pushjax.loop.shape import LimitSurfaceShape
+from pushjax.loop.variability import PUSHER_FRICTION_SOURCE, Variability
 from pushjax.loop.select import Heterogeneity, MechanismCheck, Round
 from pushjax.physics import model_file
 
@@ -48,7 +50,9 @@ def small_result(measured_friction: bool) -> report_lib.LoopResult:
                                                      n_pushes_without=43))
     floor = NoiseFloor(trans_percent=5.0, rot_percent=7.5, interval={"trans_percent": [4.0, 6.0],
                                                                      "rot_percent": [6.5, 8.5]},
-                       source="tracking", n_windows=300)
+                       source="tracking", n_windows=300,
+                       from_variability={"trans_percent": 1.0, "rot_percent": 0.5} if measured_friction else
+                       {"trans_percent": 0.0, "rot_percent": 0.0})
     rounds = [
         Round(candidates=[], additions=["cof_offset", "table_tilt", "friction_field"], gains=[0.375, 0.0625, 0.3125],
               p_values=[0.0001, 0.25, 0.0002], levels=[0.0166, 0.05, 0.025], beyond_noise=[True, False, True],
@@ -74,6 +78,9 @@ def small_result(measured_friction: bool) -> report_lib.LoopResult:
         alternatives={"cof_offset": {"friction_field": 0.125}} if measured_friction else {},
         after=_errors(0.5 if measured_friction else 0.25),  # explained without the measurement
         noise_floor=floor,
+        variability={"pusher_friction": Variability(relative_sd=0.1875, interval=[0.125, 0.25], mean=0.7890625,
+                                                    mean_std=0.015625, measurement_relative_sd=0.0125, n_pushes=40,
+                                                    source=PUSHER_FRICTION_SOURCE)} if measured_friction else {},
         pusher_friction=report_lib.PusherFriction(nominal=0.25, force_sensor=force,
                                                   from_force_sensor=measured_friction,
                                                   used=0.7890625 if measured_friction else 0.25),
@@ -123,6 +130,8 @@ def test_report_files_keep_every_key_and_byte(tmp_path):
 def test_explained_is_the_test_error_within_the_noise_floor_interval():
     report = small_result(True).report
     assert not report.explained and report.above_floor == {"trans_percent": 5.0, "rot_percent": 7.5}
+    # The spread adds 1.5 points to the tracking noise's 11: of the 25 - 11 points above the tracking noise, 1.5 / 14.
+    assert report.variability_share == 1.5 / 14
     within = report_lib.HeldOutErrors(**{**vars(report.after), "trans_percent": 6.0, "rot_percent": 8.5})
     assert report_lib.LoopReport(**{**vars(report), "after": within}).explained
 

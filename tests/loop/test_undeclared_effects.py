@@ -51,16 +51,18 @@ def test_report_follows_the_schema(loop_report):
     assert json.loads((workdir / "report.json").read_text()) == report
     assert set(report) == {"n_pushes", "baseline", "diagnosis", "ranking", "selected", "alternatives", "after",
                            "noise_floor", "pusher_friction", "explained", "fallback", "remaining", "uncertainty",
-                           "per_group", "limit_surface_shape"}
+                           "per_group", "limit_surface_shape", "variability"}
     assert set(report["alternatives"]) <= set(report["selected"])
     assert all(0.05 < p <= 1 for rivals in report["alternatives"].values() for p in rivals.values())
     assert report["per_group"] == []  # one object on one surface: no groups to fit apart
+    spread = report["variability"]["pusher_friction"]  # one pusher friction for every push: no spread between pushes
+    assert spread["interval"][0] == 0.0 and spread["relative_sd"] < 0.02 and spread["n_pushes"] > 20
     friction = report["pusher_friction"]
     assert set(friction) == {"nominal", "force_sensor", "from_force_sensor", "used"}
     assert set(friction["force_sensor"]) == {"value", "std", "n_sequences", "n_pushes", "n_pushes_without", "measured"}
     floor = report["noise_floor"]
     assert floor["source"] == "tracking" and floor["n_windows"] > 0  # no push is repeated
-    assert set(report["remaining"]) == {"above_floor", "variables"}
+    assert set(report["remaining"]) == {"above_floor", "variables", "variability_share"}
     for key in ("trans_percent", "rot_percent"):
         assert 0 <= floor["interval"][key][0] <= floor[key] <= floor["interval"][key][1]
         assert report["remaining"]["above_floor"][key] == pytest.approx(report["after"][key] - floor[key])

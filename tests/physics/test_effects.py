@@ -55,6 +55,7 @@ def _random_params(seed):
         "friction_speed": {"inverse_deceleration": jnp.asarray(rng.uniform(0, 1), jnp.float32),
                            "gain": jnp.asarray(rng.normal(0, 0.3), jnp.float32)},
         "pressure_gradient": {"offset": jnp.asarray(rng.normal(0, 0.005, 2), jnp.float32)},
+        "leading_edge": {"lever": jnp.asarray(rng.uniform(0, 0.005), jnp.float32)},
     }
 
 

@@ -1,0 +1,614 @@
+"""Learn while pushing: the controller closes the loop on the pushes it makes (``python -m experiments.adapt``).
+
+A **world** is the realistic testbed (:data:`pushjax.sim.testbed.REALISTIC`) with one effect the controller's model
+does not declare, its magnitude drawn from the world's seed (:func:`draw_world`, :data:`EFFECTS`):
+
+``tilt``                  the table tilted by 2-4 degrees towards a uniform azimuth (``Effects.table_tilt_deg``);
+``com_offset``            the centre of mass moved by 30-50 % of the distance from the centroid to the outline, in a
+                          uniform direction (``Effects.com_offset``, object axes);
+``pusher_friction``       a pusher-object coefficient of 0.08-0.15 instead of the nominal 0.25
+                          (``Effects.pusher_friction``; the testbed still spreads it per push);
+``friction_variability``  the pusher-object coefficient spread from push to push by a log-normal factor of spread
+                          0.5-0.8 instead of the realistic profile's 0.2 (``Testbed.pusher_friction_sigma``).
+
+In each world the controller (:func:`pushjax.control.closed_loop.run_episode`: motion capture and the EKF) pushes
+the objects to a sequence of ``first_block + (blocks - 1) * per_block`` goals (:func:`pushjax.control.goals.draw_goals`
+with the world's seed, the objects taking turns) three ways, the **arms** (:data:`ARMS`), on the same goals with the
+same testbed draws (paired by goal):
+
+``adaptive``  records every episode as a push file in the MIT layout (:func:`episode_push_path`); after every block of
+              episodes (the first of ``first_block``, the others of ``per_block``) the loop
+              (:func:`pushjax.loop.close_loop`) runs on ALL the pushes it recorded so far (its own pushes, not protocol
+              pushes) and the next block plans with the model it selected (its ``model.json``: effects, parameters
+              and the pusher friction the force sensor measured). Until the loop can run (it needs
+              :func:`pushjax.loop.splits.minimum_sequences` push sequences, one per episode) the controller plans with
+              plain Lynch, and the reason is recorded;
+``plain``     plain Lynch with the nominal pusher friction throughout (no adaptation);
+``oracle``    the model that knows the world's effect and magnitude (:meth:`World.oracle`): ``table_tilt`` with the
+              drift force ``tan(tilt) / mu_surface`` downhill, ``cof_offset`` at the moved centre of mass, the true
+              pusher friction, or for the variability its mean ``0.25 exp(sigma^2 / 2)``.
+
+An episode is a function of the world, the goal and the planned-with model, so an arm that plans with the same model as
+another on a goal (``adaptive`` before the loop can run, and wherever the loop's model is plain Lynch's) reuses that
+episode instead of simulating it again.
+
+Per arm and block: the success rate (:func:`pushjax.control.goals.succeeded`: within 5 mm and 5 degrees), the time to
+goal (the simulated seconds of a success; a failure counts as ``max_time``, as in
+:func:`pushjax.control.report.compare`) and the pusher's path length; for ``adaptive`` what the loop selected after
+each block. The comparison rule, fixed before any run, is :data:`COMPARISON_RULE`.
+
+Outputs (:func:`write`): ``results.json``, ``results.md`` and ``time_to_goal.png`` in the work folder; below it
+``<effect>/world=<seed>/pushes`` (the adaptive arm's push files) and ``<effect>/world=<seed>/loop/block=<b>`` (the
+loop's reports), ``<effect>/world=<seed>/episodes`` (every arm's finished episodes, so that a run over the same work
+folder resumes where an interrupted one stopped: :func:`run`). Same config, same bytes (wall-clock times are not
+recorded), whether the run was interrupted or not.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import os
+import shutil
+import zlib
+from collections.abc import Sequence
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+import shapely
+import tqdm
+
+from pushjax import outputs, stats
+from pushjax.control import closed_loop, goals, gradient, mpc
+from pushjax.control.model import make_model
+from pushjax.geometry.objects import OBJECT_NAMES, get_object
+from pushjax.loop import LoopSettings, close_loop
+from pushjax.loop.correction import CorrectionSettings
+from pushjax.loop.fit import FitSettings
+from pushjax.mit.files import PushParams, push_file_name, write_push
+from pushjax.physics.model_file import AugmentedModel
+from pushjax.sim.effects import Effects
+from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION, SURFACE_NAMES, get_surface
+from pushjax.sim.testbed import REALISTIC, Testbed
+
+__all__ = ["ARMS", "AdaptConfig", "COMPARISON_RULE", "EFFECTS", "GAP_SHARE", "SCALES", "STANDARD_ERRORS", "World",
+           "compare", "draw_world", "episode_push_path", "make_config", "run", "write"]
+
+EFFECTS = ("tilt", "com_offset", "pusher_friction", "friction_variability")
+"""The worlds' undeclared effects (see the module docstring)."""
+ARMS = ("adaptive", "plain", "oracle")
+"""The controllers compared on every goal."""
+TILT_DEG = (2.0, 4.0)
+"""Range of the table's tilt, degrees (below the abs surface's friction angle of 7.4 degrees)."""
+COM_OFFSET_SHARE = (0.3, 0.5)
+"""Range of the centre of mass's offset, as a share of the distance from the centroid to the outline."""
+PUSHER_FRICTION = (0.08, 0.15)
+"""Range of the low pusher-object coefficient (nominal 0.25)."""
+FRICTION_SIGMA = (0.5, 0.8)
+"""Range of the push-to-push spread of the pusher-object coefficient (std of its log; realistic profile: 0.2)."""
+
+GAP_SHARE = 0.5
+"""Share of the plain-oracle gap in time to goal that the adaptive controller must close."""
+STANDARD_ERRORS = stats.DECISION_STANDARD_ERRORS
+"""Standard errors (over world seeds) by which the decision must clear zero (:func:`pushjax.stats.decide`)."""
+COMPARISON_RULE = (
+    f"Fixed before any run. Per effect, in the LAST block, on the same goals (paired by goal): for every world seed w, "
+    f"d_w = mean over the block's goals of (t_plain - t_adaptive) - {GAP_SHARE:g} (t_plain - t_oracle), t the time to "
+    f"goal in s (a failed goal counts as max_time). The adaptive controller closes at least {GAP_SHARE:.0%} of the "
+    f"plain-oracle gap when mean_w d_w > {STANDARD_ERRORS:g} standard errors of that mean over world seeds (the "
+    f"resampling unit: a world's effect magnitude, goals and testbed draws are drawn together, and its goals share "
+    f"the adaptive model, so goals within a world are not independent); it falls short when mean_w d_w < "
+    f"-{STANDARD_ERRORS:g} standard errors; otherwise (or with one world seed, which gives no standard error) it is "
+    f"not decided. This is the project's decision rule (pushjax.stats.decide) on the paired difference -d_w.")
+"""The comparison rule (:func:`compare`), committed before any run."""
+
+EPISODE_FOLDER = "episode={:04d}"
+"""The folder of an episode's push file below its object's folder: one push sequence per episode
+(:func:`pushjax.loop.windows.build_examples`)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class AdaptConfig:
+    """What a run of the study does.
+
+    Attributes:
+      effects: the worlds' effects, from :data:`EFFECTS`, no repeats.
+      objects: the pushed objects (taking turns through the goals), from ``OBJECT_NAMES``, no repeats.
+      worlds: world seeds per effect: ``seed, seed + 1, ...``.
+      blocks: blocks of episodes per world.
+      per_block: episodes per block (K): the loop runs after every block.
+      first_block: episodes in the first block (None: ``per_block``): the loop first runs after them, so a first block
+        of :func:`pushjax.loop.splits.minimum_sequences` episodes (one push sequence each) lets the second block
+        plan with what the loop selected.
+      max_time: simulated seconds per goal (a failed goal's time to goal).
+      controller: the controller's settings (:class:`pushjax.control.mpc.ControllerConfig`).
+      loop: the loop's settings (:class:`pushjax.loop.LoopSettings`).
+      surface: the table's surface.
+      testbed: the testbed profile the effect is added to.
+      seed: the first world seed.
+    """
+
+    effects: tuple[str, ...]
+    objects: tuple[str, ...]
+    worlds: int
+    blocks: int
+    per_block: int
+    max_time: float
+    controller: mpc.ControllerConfig
+    loop: LoopSettings
+    first_block: int | None = None
+    surface: str = "abs"
+    testbed: Testbed = REALISTIC
+    seed: int = 0
+
+    def __post_init__(self):
+        object.__setattr__(self, "effects", tuple(self.effects))
+        object.__setattr__(self, "objects", tuple(self.objects))
+        for name, values, known in (("effects", self.effects, EFFECTS), ("objects", self.objects, OBJECT_NAMES)):
+            if not values or len(set(values)) != len(values) or not set(values) <= set(known):
+                raise ValueError(f"{name}: expected a non-empty list from {','.join(known)}, no repeats, got "
+                                 f"{','.join(values) or 'none'}")
+        for name in ("worlds", "blocks", "per_block", "first_block"):
+            value = getattr(self, name)
+            if name == "first_block" and value is None:
+                continue
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ValueError(f"{name}: expected a whole number >= 1, got {value!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            raise ValueError(f"seed: expected a whole number >= 0, got {self.seed!r}")
+        if not (math.isfinite(self.max_time) and self.max_time >= 1):
+            raise ValueError(f"max_time: expected a finite number of seconds >= 1, got {self.max_time!r}")
+        if self.surface not in SURFACE_NAMES:
+            raise ValueError(f"surface: expected one of {','.join(SURFACE_NAMES)}, got {self.surface!r}")
+        if self.testbed.ideal:
+            raise ValueError("testbed: expected a testbed with motion capture and draws (not the ideal profile), "
+                             "whose pusher_friction_sigma the friction_variability effect replaces")
+
+    @property
+    def world_seeds(self) -> tuple[int, ...]:
+        return tuple(range(self.seed, self.seed + self.worlds))
+
+    @property
+    def episodes(self) -> int:
+        """Episodes per world and arm."""
+        return self.block_start(self.blocks)
+
+    def block_start(self, block: int) -> int:
+        """The number of the first episode of block `block` (0-based; ``blocks``: the episodes in all)."""
+        first = self.per_block if self.first_block is None else self.first_block
+        return 0 if block == 0 else first + (block - 1) * self.per_block
+
+    def as_dict(self) -> dict:
+        """The settings as JSON-able values."""
+        return {"effects": list(self.effects), "objects": list(self.objects), "worlds": self.worlds,
+                "world_seeds": list(self.world_seeds), "blocks": self.blocks, "per_block": self.per_block,
+                "first_block": self.block_start(1), "max_time": self.max_time, "controller": repr(self.controller),
+                "loop": dataclasses.asdict(self.loop), "surface": self.surface, "testbed": self.testbed.to_dict(),
+                "seed": self.seed}
+
+
+_SMOKE_CONTROLLER = mpc.ControllerConfig(horizon=8, gradient=gradient.GradientConfig(iterations=15), candidates=16)
+SCALES = {
+    # A test of the whole path: one object and world; a first block of 16 episodes of 6 s (the loop needs 12 push
+    # sequences, and the force sensor 8 sliding ones among the 12 it does not test on: 10 slide), after which the loop
+    # runs on the controller's own pushes and the second block (2 episodes) plans with its model. The pusher friction
+    # is the world's effect and the loop's one candidate: the force sensor measures it, so the loop's model plans with
+    # the measured coefficient instead of the nominal 0.25, and the arms share one compiled controller (the friction
+    # only changes the model's mu). A reduced fit, bootstrap and learned error term.
+    "smoke": AdaptConfig(effects=("pusher_friction",), objects=("rect1",), worlds=1, blocks=2, per_block=2,
+                         first_block=16, max_time=6.0, controller=_SMOKE_CONTROLLER,
+                         loop=LoopSettings(stride=0.5, n_bootstrap=100, effects=("pusher_friction",),
+                                           fit=FitSettings(steps=20, warm_steps=10),
+                                           correction=CorrectionSettings(steps=100, eval_every=50, hidden=(16,)))),
+    # Every effect in 3 worlds; 4 blocks of 6 goals: the loop first runs after 12 episodes (block 2), so blocks 3 and
+    # 4 plan with what it selected. About 3 x 24 episodes of at most 30 s per world, and 4 loop runs.
+    "cpu": AdaptConfig(effects=EFFECTS, objects=("rect1",), worlds=3, blocks=4, per_block=6, max_time=30.0,
+                       controller=mpc.ControllerConfig(), loop=LoopSettings()),
+}
+"""The study's scales, defined here and only here."""
+
+
+def make_config(scale: str, **overrides) -> AdaptConfig:
+    """``SCALES[scale]`` with the fields in `overrides` that are not None replaced (validated: ValueError naming the
+    field)."""
+    if scale not in SCALES:
+        raise ValueError(f"scale: expected one of {','.join(SCALES)}, got {scale!r}")
+    return dataclasses.replace(SCALES[scale], **{key: value for key, value in overrides.items() if value is not None})
+
+
+@dataclasses.dataclass(frozen=True)
+class World:
+    """One world: an effect and its magnitude.
+
+    Attributes:
+      effect: from :data:`EFFECTS`.
+      seed: the world's seed (its magnitude, goals and testbed draws).
+      magnitude: the drawn magnitude in readable units (JSON-able; e.g. ``{"tilt_deg", "azimuth_deg"}``).
+      effects: {object: the testbed's :class:`pushjax.sim.effects.Effects`}.
+      testbed: the testbed profile.
+      oracle: {object: the model that knows the effect (:class:`pushjax.physics.model_file.AugmentedModel`)}.
+    """
+
+    effect: str
+    seed: int
+    magnitude: dict
+    effects: dict[str, Effects]
+    testbed: Testbed
+    oracle: dict[str, AugmentedModel]
+
+
+def draw_world(effect: str, seed: int, objects: Sequence[str], surface: str = "abs",
+               testbed: Testbed = REALISTIC) -> World:
+    """The world of `effect` with seed `seed`: its magnitude drawn from ``default_rng([seed, crc32(effect)])`` (see
+    the module docstring for the ranges), for `objects` on `surface`."""
+    if effect not in EFFECTS:
+        raise ValueError(f"effect: expected one of {','.join(EFFECTS)}, got {effect!r}")
+    rng = np.random.default_rng([seed, zlib.crc32(effect.encode("utf-8"))])
+    if effect == "tilt":
+        tilt, azimuth = rng.uniform(*TILT_DEG), rng.uniform(0.0, 360.0)
+        drift = math.tan(math.radians(tilt)) / get_surface(surface).object_friction
+        downhill = [drift * math.cos(math.radians(azimuth)), drift * math.sin(math.radians(azimuth))]
+        oracle = AugmentedModel.create(("table_tilt",), {"table_tilt": {"drift_force": downhill}},
+                                       PUSHER_OBJECT_FRICTION)
+        return World(effect, seed, {"tilt_deg": tilt, "azimuth_deg": azimuth, "drift_force": downhill},
+                     {obj: Effects(table_tilt_deg=tilt, table_tilt_azimuth_deg=azimuth) for obj in objects}, testbed,
+                     {obj: oracle for obj in objects})
+    if effect == "com_offset":
+        share, direction = rng.uniform(*COM_OFFSET_SHARE), rng.uniform(-math.pi, math.pi)
+        offsets = {}
+        for obj in objects:
+            shape = get_object(obj)
+            inside = shape.polygon.exterior.distance(shapely.Point(*shape.centroid))
+            offsets[obj] = [share * inside * math.cos(direction), share * inside * math.sin(direction)]
+        return World(effect, seed, {"share_of_inradius": share, "direction_deg": math.degrees(direction),
+                                    "offset_m": offsets},
+                     {obj: Effects(com_offset=offsets[obj]) for obj in objects}, testbed,
+                     {obj: AugmentedModel.create(("cof_offset",), {"cof_offset": {"offset": offsets[obj]}},
+                                                 PUSHER_OBJECT_FRICTION) for obj in objects})
+    if effect == "pusher_friction":
+        mu = rng.uniform(*PUSHER_FRICTION)
+        return World(effect, seed, {"pusher_friction": mu}, {obj: Effects(pusher_friction=mu) for obj in objects},
+                     testbed, {obj: AugmentedModel.create((), {}, mu) for obj in objects})
+    sigma = rng.uniform(*FRICTION_SIGMA)
+    mean = PUSHER_OBJECT_FRICTION * math.exp(sigma ** 2 / 2)
+    return World(effect, seed, {"pusher_friction_sigma": sigma, "mean_pusher_friction": mean},
+                 {obj: Effects() for obj in objects}, dataclasses.replace(testbed, pusher_friction_sigma=sigma),
+                 {obj: AugmentedModel.create((), {}, mean) for obj in objects})
+
+
+def episode_push_path(data_dir: str | Path, surface: str, obj: str, episode: int, speed_limit: float) -> Path:
+    """The push file of episode `episode` (its number in the world's sequence) in the MIT layout, one folder per
+    episode so that each is a push sequence of its own (:func:`pushjax.loop.windows.build_examples`):
+    ``<data_dir>/<surface>/<obj>/episode=<NNNN>/motion_surface=<surface>_shape=<obj>_a=0_v=<speed limit, mm/s>_i=0_
+    s=0.000_t=0.000.h5``. The file-name fields of an episode: ``a=0`` (no protocol acceleration), ``v`` the
+    controller's speed limit in mm/s, and ``i``, ``s``, ``t`` 0, since the controller chooses its contacts (side,
+    point and angle) anew every plan; fields equal in every push are no candidate variables of the loop's
+    diagnosis."""
+    params = PushParams(surface=surface, shape=obj, acceleration=0.0, velocity=round(speed_limit * 1e3, 6), side=0,
+                        point=0.0, angle=0.0)
+    return Path(data_dir) / surface / obj / EPISODE_FOLDER.format(episode) / push_file_name(params)
+
+
+def _tasks(objects: Sequence[str], count: int, seed: int) -> list[goals.Goal]:
+    """The world's first `count` goals, the objects taking turns (goal index first, then object order)."""
+    drawn = goals.draw_goals(objects, math.ceil(count / len(objects)), seed)
+    order = {obj: k for k, obj in enumerate(objects)}
+    return sorted(drawn, key=lambda task: (task.index, order[task.obj]))[:count]
+
+
+EPISODE_RECORD = "episodes/" + EPISODE_FOLDER + "/{}.json"
+"""An arm's finished episode below its world's folder (:func:`run`): ``episodes/episode=<NNNN>/<arm>.json``."""
+LOOP_RECORD = "adapt_record.json"
+"""What the next block plans with, in the loop's report folder of the block (:func:`run`)."""
+
+
+def _digest(inputs: dict) -> str:
+    return hashlib.sha256(json.dumps(inputs, sort_keys=True, default=repr).encode("utf-8")).hexdigest()
+
+
+def _read_record(path: Path, key: str) -> dict | None:
+    """The record in `path` when it is finished and was made from the inputs whose digest is `key`; else None."""
+    try:
+        record = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    return record if isinstance(record, dict) and record.get("key") == key else None
+
+
+def _write_record(path: Path, record: dict) -> dict:
+    """Writes `record` as JSON to `path` through a temporary file renamed into place (an interrupted write leaves no
+    record, only a hidden ``.partial`` file); returns the record as it reads back."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    text = json.dumps(record, indent=1, sort_keys=True) + "\n"
+    partial = path.with_name(f".{path.name}.{os.getpid()}.partial")
+    partial.write_text(text)
+    os.replace(partial, path)
+    return json.loads(text)
+
+
+def _episode_inputs(config: AdaptConfig, world: World, task: goals.Goal, spec: AugmentedModel) -> dict:
+    """Everything an episode is a function of (the world, the goal, the planned-with model, the settings)."""
+    return {"effect": world.effect, "world": world.seed, "magnitude": world.magnitude,
+            "testbed": world.testbed.to_dict(), "effects": repr(world.effects[task.obj]), "object": task.obj,
+            "index": task.index, "start": [float(value) for value in task.start],
+            "goal": [float(value) for value in task.goal], "model": spec.as_dict(),
+            "controller": repr(config.controller), "max_time": config.max_time, "surface": config.surface}
+
+
+def _outcome(result: closed_loop.EpisodeResult) -> dict:
+    """What the rows need of an episode (JSON values)."""
+    return {"time_s": float(result.time), "position_error_m": float(result.position_error),
+            "yaw_error_rad": float(result.yaw_error), "path_length_m": float(result.path_length),
+            "stop": str(result.stop), "plans": int(result.plans), "repositions": int(result.repositions)}
+
+
+def _model(summary: dict) -> AugmentedModel:
+    return AugmentedModel.create(summary["effects"], summary["params"], summary["pusher_friction"])
+
+
+def _remove_pushes_from(data_dir: Path, first: int) -> None:
+    """Removes the push folders of episodes `first` and later below `data_dir` (a former run's, which the loop of an
+    earlier block must not see)."""
+    for episode in sorted(data_dir.glob("*/*/episode=*")):
+        number = episode.name.removeprefix("episode=")
+        if episode.is_dir() and number.isdigit() and int(number) >= first:
+            shutil.rmtree(episode)
+
+
+def run(config: AdaptConfig, workdir: str | Path) -> dict:
+    """Runs the study (see the module docstring); writes the push files, the loop's reports and the records below
+    `workdir`.
+
+    Resuming: every arm's finished episode is recorded (:data:`EPISODE_RECORD`, written after the adaptive arm's push
+    file, renamed into place) with the digest of what it is a function of (the world, the goal, the planned-with
+    model, the controller, ``max_time``, the surface), and so is every loop run (:data:`LOOP_RECORD`: the loop's
+    settings and the digests of the pushes it ran on). A run over a workdir that holds them reads them back instead of
+    simulating or running the loop again (the adaptive arm's push file must be there too), so an interrupted run
+    continues where it stopped and gives the bytes an uninterrupted run gives. A record of other inputs is made
+    again; before the loop runs, any push files of later episodes (a former run's) are removed. The records do not
+    know the code: after changing it, start from an empty workdir.
+
+    Returns:
+      ``{"study", "settings", "comparison_rule", "worlds", "episodes", "loop", "rows", "comparison"}``: ``episodes``
+      one row per arm and goal (``effect, world, arm, block, episode, object, index, success, time_to_goal_s, time_s,
+      position_error_mm, yaw_error_deg, path_length_m, stop, plans, repositions, model``), ``loop`` one row per world
+      and block (``effect, world, block, pushes, ran, selected, model, reason``: what the next block plans with and
+      why), ``rows`` per effect, arm and block (:func:`_block_rows`), ``comparison`` per effect (:func:`compare`).
+    """
+    workdir = Path(workdir)
+    episodes, loops, worlds = [], [], []
+    counts = dict.fromkeys(("simulated", "read back", "loop runs", "loop runs read back"), 0)
+    plain = AugmentedModel.create((), {}, PUSHER_OBJECT_FRICTION)
+    total = len(config.effects) * config.worlds * config.episodes * len(ARMS)
+    with tqdm.tqdm(total=total, desc="adapt: pushing to goals", unit="episode") as bar:
+        for effect in config.effects:
+            for seed in config.world_seeds:
+                world = draw_world(effect, seed, config.objects, config.surface, config.testbed)
+                worlds.append({"effect": effect, "seed": seed, "magnitude": world.magnitude,
+                               "oracle": {obj: spec.as_dict() for obj, spec in world.oracle.items()}})
+                folder = workdir / effect / f"world={seed}"
+                data_dir = folder / "pushes"
+                tasks = _tasks(config.objects, config.episodes, seed)
+                outcomes: dict[str, dict] = {}  # digest of an episode's inputs -> its outcome (simulated or read)
+                recordings: dict[str, closed_loop.EpisodeResult] = {}  # ... -> the episode, simulated in this run
+                pushed = []  # the digests of the adaptive arm's episodes so far
+                adaptive = None  # the loop's model; None: plain Lynch
+                for block in range(config.blocks):
+                    for number in range(config.block_start(block), config.block_start(block + 1)):
+                        task = tasks[number]
+                        loop = closed_loop.LoopConfig(max_time=config.max_time, surface=config.surface,
+                                                      testbed=world.testbed, effects=world.effects[task.obj])
+                        for arm in ARMS:
+                            spec = {"adaptive": adaptive or plain, "plain": plain,
+                                    "oracle": world.oracle[task.obj]}[arm]
+                            inputs = _episode_inputs(config, world, task, spec)
+                            key = _digest(inputs)
+                            path = folder / EPISODE_RECORD.format(number, arm)
+                            push_path = (episode_push_path(data_dir, config.surface, task.obj, number,
+                                                           config.controller.speed_limit) if arm == "adaptive"
+                                         else None)
+                            bar.set_postfix_str(f"{effect} world {seed} block {block + 1} {arm}")
+                            record = _read_record(path, key)
+                            if record is not None and (push_path is None or push_path.is_file()):
+                                counts["read back"] += 1
+                            else:
+                                # An arm that plans with the same model on this goal as another pushes as it did.
+                                if key not in (outcomes if push_path is None else recordings):
+                                    model = make_model(task.obj, mu=spec.mu, effects=spec.effects, params=spec.params)
+                                    recordings[key] = closed_loop.run_episode(
+                                        model, config.controller, task.obj, task.start, task.goal, seed=seed,
+                                        index=task.index, loop=loop)
+                                    outcomes[key] = _outcome(recordings[key])
+                                    counts["simulated"] += 1
+                                if push_path is not None:
+                                    recording = recordings[key].recording
+                                    write_push(push_path, None, recording.tip_pose, recording.object_pose,
+                                               recording.ft_wrench)
+                                record = _write_record(path, {"key": key, "inputs": inputs, "outcome": outcomes[key]})
+                            outcomes.setdefault(key, record["outcome"])
+                            if arm == "adaptive":
+                                pushed.append(key)
+                            episodes.append(_episode_row(effect, seed, arm, block, number, task, record["outcome"],
+                                                         spec, config.max_time))
+                            bar.update()
+                    end = config.block_start(block + 1)
+                    bar.set_postfix_str(f"{effect} world {seed}: closing the loop on {end} pushes")
+                    inputs = {"loop": dataclasses.asdict(config.loop), "seed": seed, "pushes": pushed}
+                    key = _digest(inputs)
+                    report_dir = folder / "loop" / f"block={block}"
+                    record = _read_record(report_dir / LOOP_RECORD, key)
+                    if record is not None:
+                        counts["loop runs read back"] += 1
+                    else:
+                        _remove_pushes_from(data_dir, end)
+                        record = _write_record(report_dir / LOOP_RECORD, {
+                            "key": key, "inputs": inputs,
+                            "row": _loop_row(data_dir, report_dir, config.loop, seed)})
+                        counts["loop runs"] += 1
+                    row = record["row"]
+                    adaptive = _model(row["model"]) if row["ran"] else None
+                    loops.append({"effect": effect, "world": seed, "block": block, "pushes": end, **row})
+    tqdm.tqdm.write(f"adapt: {counts['simulated']} episodes simulated, {counts['read back']} read back; the loop ran "
+                    f"{counts['loop runs']} times, {counts['loop runs read back']} read back ({workdir})")
+    results = {"study": "adapt", "settings": config.as_dict(), "comparison_rule": COMPARISON_RULE, "worlds": worlds,
+               "episodes": episodes, "loop": loops, "rows": _block_rows(episodes),
+               "comparison": {effect: compare([row for row in episodes if row["effect"] == effect],
+                                              config.blocks - 1) for effect in config.effects}}
+    return outputs.compact(results)
+
+
+def _loop_row(data_dir: Path, report_dir: Path, settings: LoopSettings, seed: int) -> dict:
+    """Runs the loop on the pushes in `data_dir` (reports in `report_dir`): ``ran, selected, model, reason``, what the
+    next block plans with (``model``: the loop's, :meth:`AugmentedModel.as_dict`; None: plain Lynch) and why."""
+    try:
+        found = close_loop(data_dir, report_dir, settings, seed=seed, progress=False)
+    except ValueError as error:
+        return {"ran": False, "selected": [], "model": None,
+                "reason": f"plain Lynch: the loop cannot run yet ({' '.join(str(error).split())})"}
+    selected = list(found.report.selected)
+    return {"ran": True, "selected": selected, "model": found.model.as_dict(),
+            "reason": ("the loop's model: " + (" + ".join(selected) if selected else "nothing selected (Lynch)")
+                       + f", pusher friction {found.model.mu:.3f}")}
+
+
+def _episode_row(effect: str, world: int, arm: str, block: int, number: int, task: goals.Goal, outcome: dict,
+                 spec: AugmentedModel, max_time: float) -> dict:
+    success = goals.succeeded(outcome["position_error_m"], outcome["yaw_error_rad"])
+    return {"effect": effect, "world": world, "arm": arm, "block": block, "episode": number, "object": task.obj,
+            "index": task.index, "goal": list(task.goal), "success": success,
+            "time_to_goal_s": outcome["time_s"] if success else max_time, "time_s": outcome["time_s"],
+            "position_error_mm": 1e3 * outcome["position_error_m"],
+            "yaw_error_deg": math.degrees(outcome["yaw_error_rad"]), "path_length_m": outcome["path_length_m"],
+            "stop": outcome["stop"], "plans": outcome["plans"], "repositions": outcome["repositions"],
+            "model": {"effects": list(spec.effects), "pusher_friction": spec.mu}}
+
+
+def _mean_and_error(values: Sequence[float]) -> tuple[float, float | None]:
+    """(mean, standard error of the mean; None for fewer than 2 values: no spread to estimate it from)."""
+    values = np.asarray(values, np.float64)
+    error = float(np.std(values, ddof=1) / math.sqrt(len(values))) if len(values) > 1 else None
+    return float(np.mean(values)), error
+
+
+def _block_rows(episodes: Sequence[dict]) -> list[dict]:
+    """Per effect, arm and block: ``episodes``, ``worlds``, ``success_rate``, ``time_to_goal_s`` (mean over world
+    seeds of the worlds' block means) with ``time_to_goal_se_s`` (its standard error over world seeds; None with one),
+    ``path_length_m`` (mean, m)."""
+    rows = []
+    keys = sorted({(row["effect"], row["arm"], row["block"]) for row in episodes},
+                  key=lambda key: (key[0], ARMS.index(key[1]), key[2]))
+    for effect, arm, block in keys:
+        chosen = [row for row in episodes if (row["effect"], row["arm"], row["block"]) == (effect, arm, block)]
+        worlds = sorted({row["world"] for row in chosen})
+        mean, error = _mean_and_error([np.mean([row["time_to_goal_s"] for row in chosen if row["world"] == world])
+                                       for world in worlds])
+        rows.append({"effect": effect, "arm": arm, "block": block, "episodes": len(chosen), "worlds": len(worlds),
+                     "success_rate": float(np.mean([row["success"] for row in chosen])), "time_to_goal_s": mean,
+                     "time_to_goal_se_s": error,
+                     "path_length_m": float(np.mean([row["path_length_m"] for row in chosen]))})
+    return rows
+
+
+VERDICTS = {stats.HOLDS: "closes the gap", stats.FAILS: "falls short", stats.UNDECIDED: "not decided"}
+"""The comparison's verdict for each of :func:`pushjax.stats.decide`'s on the claim "the adaptive controller's time to
+goal beats the midpoint of plain's and the oracle's" (that is, it closes :data:`GAP_SHARE` of the gap)."""
+
+
+def compare(episodes: Sequence[dict], block: int) -> dict:
+    """The comparison rule (:data:`COMPARISON_RULE`) on one effect's episode rows, in block `block` (0-based).
+
+    The decision is :func:`pushjax.stats.decide` (the project's one rule) on the paired difference ``-d`` (the
+    adaptive arm's time minus the plain-oracle midpoint's, lower is better) and its standard error over world seeds.
+
+    Returns:
+      ``{"block", "worlds", "goals", "plain_minus_oracle_s", "plain_minus_adaptive_s", "gap_closed_share",
+      "criterion_s": {"mean", "standard_error"}, "verdict", "reason"}``: times in s (means over world seeds), the share
+      of the gap closed (None without a gap), the standard error None with one world seed, the verdict
+      (:data:`VERDICTS`) and why.
+    """
+    times = {(row["world"], row["arm"], row["object"], row["index"]): row["time_to_goal_s"] for row in episodes
+             if row["block"] == block}
+    goals_by_world = {}
+    for world, arm, obj, index in times:
+        if arm == "plain" and all((world, other, obj, index) in times for other in ARMS):
+            goals_by_world.setdefault(world, []).append((obj, index))
+    per_world = {"criterion": [], "gap": [], "closed": []}
+    for world, tasks in sorted(goals_by_world.items()):
+        plain = np.array([times[(world, "plain", *task)] for task in tasks])
+        adaptive = np.array([times[(world, "adaptive", *task)] for task in tasks])
+        oracle = np.array([times[(world, "oracle", *task)] for task in tasks])
+        per_world["criterion"].append(float(np.mean((plain - adaptive) - GAP_SHARE * (plain - oracle))))
+        per_world["gap"].append(float(np.mean(plain - oracle)))
+        per_world["closed"].append(float(np.mean(plain - adaptive)))
+    if not per_world["criterion"]:
+        return {"block": block, "worlds": 0, "goals": 0, "verdict": VERDICTS[stats.UNDECIDED],
+                "reason": "no goal of the block was pushed by every arm"}
+    mean, error = _mean_and_error(per_world["criterion"])
+    verdict = VERDICTS[stats.decide(-mean, error)]
+    if error is None:
+        reason = "one world seed: no standard error over world seeds"
+    elif verdict == VERDICTS[stats.UNDECIDED]:
+        reason = f"the criterion is within {STANDARD_ERRORS:g} standard errors of zero"
+    else:
+        reason = f"the criterion is {abs(mean) / error:.1f} standard errors from zero" if error > 0 else (
+            "the criterion is the same in every world")
+    gap, closed = float(np.mean(per_world["gap"])), float(np.mean(per_world["closed"]))
+    return {"block": block, "worlds": len(goals_by_world), "goals": sum(map(len, goals_by_world.values())),
+            "plain_minus_oracle_s": gap, "plain_minus_adaptive_s": closed,
+            "gap_closed_share": closed / gap if gap != 0 else None,
+            "criterion_s": {"mean": mean, "standard_error": error}, "verdict": verdict, "reason": reason}
+
+
+def _format(value: float | None, spec: str, missing: str = "n/a") -> str:
+    return missing if value is None else format(value, spec)
+
+
+def _markdown(results: dict) -> str:
+    lines = ["# Learn while pushing", "", results["comparison_rule"], ""]
+    for effect, comparison in results["comparison"].items():
+        lines += [f"## {effect}", "", "| arm | block | episodes | success | time to goal (s) | path length (m) |",
+                  "|---|---:|---:|---:|---:|---:|"]
+        for row in results["rows"]:
+            if row["effect"] == effect:
+                error = row["time_to_goal_se_s"]
+                spread = "" if error is None else f" ± {error:.1f}"
+                lines.append(f"| {row['arm']} | {row['block'] + 1} | {row['episodes']} | {row['success_rate']:.0%} | "
+                             f"{row['time_to_goal_s']:.1f}{spread} | {row['path_length_m']:.3f} |")
+        lines += ["", "What the adaptive arm plans with after each block:", ""]
+        lines += [f"- world {row['world']}, after block {row['block'] + 1} ({row['pushes']} pushes): {row['reason']}"
+                  for row in results["loop"] if row["effect"] == effect]
+        criterion = comparison.get("criterion_s", {"mean": None, "standard_error": None})
+        lines += ["", f"Last block ({comparison['goals']} goals, {comparison['worlds']} worlds): criterion "
+                      f"{_format(criterion['mean'], '+.2f')} ± {_format(criterion['standard_error'], '.2f')} s, gap "
+                      f"closed {_format(comparison.get('gap_closed_share'), '.0%')}: **{comparison['verdict']}** "
+                      f"({comparison['reason']})", ""]
+    return "\n".join(lines)
+
+
+def _figure(results: dict, path: Path) -> None:
+    effects = list(results["comparison"])
+    figure, axes = plt.subplots(1, len(effects), figsize=(4.5 * len(effects), 3.5), squeeze=False)
+    for axis, effect in zip(axes[0], effects):
+        for arm in ARMS:
+            rows = [row for row in results["rows"] if row["effect"] == effect and row["arm"] == arm]
+            blocks = [row["block"] + 1 for row in rows]
+            errors = [row["time_to_goal_se_s"] or 0.0 for row in rows]
+            axis.errorbar(blocks, [row["time_to_goal_s"] for row in rows], yerr=errors, marker="o", capsize=3,
+                          label=arm)
+        axis.set_title(effect)
+        axis.set_xlabel("block")
+        axis.set_ylabel("time to goal (s; failure = max time)")
+        axis.set_xticks(sorted({row["block"] + 1 for row in results["rows"]}))
+    axes[0][0].legend()
+    figure.tight_layout()
+    figure.savefig(path, dpi=100, metadata={"Software": None})
+    plt.close(figure)
+
+
+def write(results: dict, workdir: str | Path) -> list[Path]:
+    """Writes ``results.json``, ``results.md`` and ``time_to_goal.png`` (time to goal by block, per effect and arm)
+    to `workdir`; returns their paths."""
+    return outputs.write_results(workdir, results, _markdown(results), "time_to_goal.png", _figure)
