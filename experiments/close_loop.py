@@ -82,7 +82,8 @@ def summary(report: dict, workdir: str) -> str:
 
     remaining = [entry["variable"] for entry in report["remaining"]["variables"]]
     return "\n".join([
-        f"{report['n_pushes']} pushes; selected: {', '.join(report['selected']) or 'nothing (plain Lynch)'}",
+        f"pushes: {', '.join(f'{role} {count}' for role, count in report['n_pushes'].items())}; selected: "
+        f"{', '.join(report['selected']) or 'nothing (plain Lynch)'}",
         f"test error, % of zero (translation / rotation): plain Lynch {errors(report['baseline'])}, selected "
         f"{errors(report['after'])}, with the learned error term {errors(report['fallback'])}; noise floor "
         f"{errors(report['noise_floor'])}",
