@@ -52,6 +52,7 @@ import json
 import math
 import os
 import shutil
+import time
 import zlib
 from collections.abc import Sequence
 from pathlib import Path
@@ -381,6 +382,7 @@ def run(config: AdaptConfig, workdir: str | Path) -> dict:
     workdir = Path(workdir)
     episodes, loops, worlds = [], [], []
     counts = dict.fromkeys(("simulated", "read back", "loop runs", "loop runs read back"), 0)
+    seconds = dict.fromkeys(("episodes", "loop"), 0.0)  # wall time, printed only (records stay byte-identical)
     plain = AugmentedModel.create((), {}, PUSHER_OBJECT_FRICTION)
     total = len(config.effects) * config.worlds * config.episodes * len(ARMS)
     with tqdm.tqdm(total=total, desc="adapt: pushing to goals", unit="episode") as bar:
@@ -418,9 +420,11 @@ def run(config: AdaptConfig, workdir: str | Path) -> dict:
                                 # An arm that plans with the same model on this goal as another pushes as it did.
                                 if key not in (outcomes if push_path is None else recordings):
                                     model = make_model(task.obj, mu=spec.mu, effects=spec.effects, params=spec.params)
+                                    began = time.perf_counter()
                                     recordings[key] = closed_loop.run_episode(
                                         model, config.controller, task.obj, task.start, task.goal, seed=seed,
                                         index=task.index, loop=loop)
+                                    seconds["episodes"] += time.perf_counter() - began
                                     outcomes[key] = _outcome(recordings[key])
                                     counts["simulated"] += 1
                                 if push_path is not None:
@@ -444,15 +448,22 @@ def run(config: AdaptConfig, workdir: str | Path) -> dict:
                         counts["loop runs read back"] += 1
                     else:
                         _remove_pushes_from(data_dir, end)
+                        began = time.perf_counter()
                         record = _write_record(report_dir / LOOP_RECORD, {
                             "key": key, "inputs": inputs,
                             "row": _loop_row(data_dir, report_dir, config.loop, seed)})
+                        seconds["loop"] += time.perf_counter() - began
                         counts["loop runs"] += 1
                     row = record["row"]
                     adaptive = _model(row["model"]) if row["ran"] else None
                     loops.append({"effect": effect, "world": seed, "block": block, "pushes": end, **row})
     tqdm.tqdm.write(f"adapt: {counts['simulated']} episodes simulated, {counts['read back']} read back; the loop ran "
                     f"{counts['loop runs']} times, {counts['loop runs read back']} read back ({workdir})")
+    if counts["simulated"] or counts["loop runs"]:
+        tqdm.tqdm.write(f"adapt: {seconds['episodes']:.1f} s simulating and planning "
+                        f"({60 * counts['simulated'] / max(seconds['episodes'], 1e-9):.1f} episodes a minute), "
+                        f"{seconds['loop']:.1f} s in the loop ({seconds['loop'] / max(counts['loop runs'], 1):.1f} s "
+                        "an update), compilation included")
     results = {"study": "adapt", "settings": config.as_dict(), "comparison_rule": COMPARISON_RULE, "worlds": worlds,
                "episodes": episodes, "loop": loops, "rows": _block_rows(episodes),
                "comparison": {effect: compare([row for row in episodes if row["effect"] == effect],
