@@ -1,5 +1,6 @@
 """An experiment's outputs in its work directory: ``results.json``, the markdown tables and one figure; a study's
-``results.json`` and ``results.md`` (`write_report`), its numbers rounded to 7 digits (`compact`)."""
+``results.json`` and ``results.md`` (`write_report`), its numbers rounded to 7 digits (`compact`). Every
+``results.json`` written here names the code that made it (``provenance``: `pushjax.provenance.write_source_diff`)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,8 @@ import math
 import os
 from collections.abc import Callable, Mapping
 from pathlib import Path
+
+from pushjax import provenance
 
 
 def compact(value):
@@ -28,7 +31,7 @@ def write_report(workdir: str | os.PathLike, results: Mapping, markdown: str) ->
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     paths = [workdir / "results.json", workdir / "results.md"]
-    paths[0].write_text(json.dumps(compact(results), indent=1) + "\n")
+    paths[0].write_text(json.dumps(compact(_with_provenance(results, workdir)), indent=1) + "\n")
     paths[1].write_text(markdown)
     return paths
 
@@ -40,7 +43,13 @@ def write_results(workdir: str | os.PathLike, results: dict, tables: str, figure
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     paths = [workdir / "results.json", workdir / "results.md", workdir / figure_name]
-    paths[0].write_text(json.dumps(results, indent=1))
+    paths[0].write_text(json.dumps(_with_provenance(results, workdir), indent=1))
     paths[1].write_text(tables)
     draw(results, paths[2])
     return paths
+
+
+def _with_provenance(results: Mapping, workdir: Path) -> dict:
+    """`results` with ``provenance``: the commit of the code writing them, and for changed code the diff beside them
+    (nothing outside a git checkout)."""
+    return {**results, "provenance": provenance.write_source_diff(workdir, provenance.source_state())}

@@ -38,9 +38,9 @@ from pathlib import Path
 import jax
 import numpy as np
 
-from pushjax import outputs, train as train_lib
+from pushjax import outputs, provenance as provenance_lib, train as train_lib
 from pushjax.models import ModelConfig
-from pushjax.paper import paths, runner, spec as spec_lib
+from pushjax.paper import runner, spec as spec_lib
 from pushjax.train import convergence, evaluate
 
 NAME = "data_efficiency_full"
@@ -198,7 +198,7 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Traini
     parameters to a checkpoint there (`pushjax.train.predictor.save_model`, replacing any earlier one); with
     `resume_dir`, its training state is saved there as it trains and a later call continues from it
     (`pushjax.train.convergence.train_until_converged`). `provenance` is the code's commit (and the diff of changed
-    code, `pushjax.paper.paths.write_source_diff`) as the run started; None: the checkout's commit now."""
+    code, `pushjax.provenance.write_source_diff`) as the run started; None: the checkout's commit now."""
     model_spec = train_examples.model_spec(unit)
     size = len(model_spec.train_indices)
     config = train_config(spec, unit)
@@ -233,7 +233,7 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Traini
         "steps_per_second": trained.steps_per_second, "started": started.isoformat(timespec="seconds"),
         "device": device_description(),
         **(provenance if provenance is not None else
-           ({"commit": commit} if (commit := paths.git_commit()) else {})),
+           ({"commit": commit} if (commit := provenance_lib.git_commit()) else {})),
     })
 
 
@@ -269,7 +269,7 @@ def assemble(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence
     return {"name": NAME, "config": config, "rows": rows, "curves": curves,
             "progress": {"planned": len(units), "done": sum(unit.key in done for unit in units),
                          "missing": [unit.key for unit in units if unit.key not in done]},
-            "provenance": {**({"commit": commit} if (commit := paths.git_commit()) else {}),
+            "provenance": {**({"commit": commit} if (commit := provenance_lib.git_commit()) else {}),
                            "model_seconds": round(train_seconds, 1)}}
 
 
@@ -307,7 +307,7 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
         _write_json(workdir / "baselines.json", outputs.compact(baseline_rows(spec, test)))
     done = records(workdir)
     todo = [unit for unit in units if needs_training(unit, done, criterion, len(splits["train"]))]
-    provenance = paths.write_source_diff(workdir, paths.source_state())  # the code this process runs
+    provenance = provenance_lib.write_source_diff(workdir, provenance_lib.source_state())  # the code this process runs
     log(f"{NAME}: {len(units) - len(todo)} of {len(units)} models recorded in {workdir}/models, {len(todo)} to train")
     if todo and (max_models is None or max_models > 0):
         validation = train_lib.examples_from_source(splits["validation"], fields)

@@ -2,7 +2,7 @@
 
 They are read from a ``paper_tables.json`` (Tables 1-5, Sec. V, the text of Figs. 6, 7 and 9): the file named by
 the environment variable ``PUSHJAX_PAPER_TABLES``, else ``../shared/data/paper_tables.json`` beside the
-source checkout (`pushjax.paper.paths.source_checkout`; an installed pushjax needs the variable). Without it every lookup returns None and the tables have no paper column; nothing else changes.
+source checkout (`pushjax.provenance.source_checkout`; an installed pushjax needs the variable). Without it every lookup returns None and the tables have no paper column; nothing else changes.
 
 Our training sizes map to the paper's by role: 2 500 is 2 500, and an experiment's largest size is the paper's
 largest (Table 1: 190 000, Table 3: 114 000), whatever our scale makes it (``cpu``: 19 800 and 11 664).
@@ -16,7 +16,7 @@ import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-from pushjax.paper import paths
+from pushjax import provenance
 
 ENVIRONMENT_VARIABLE = "PUSHJAX_PAPER_TABLES"
 
@@ -30,7 +30,7 @@ _TEXT = {"velocities": ("fig6_velocities", "text"), "objects": ("fig7_objects", 
 def path() -> Path | None:
     """The ``paper_tables.json`` in use, or None when there is none."""
     named = os.environ.get(ENVIRONMENT_VARIABLE)
-    checkout = paths.source_checkout()
+    checkout = provenance.source_checkout()
     candidate = (Path(named) if named else
                  None if checkout is None else checkout.parent / "shared" / "data" / "paper_tables.json")
     return candidate if candidate is not None and candidate.is_file() else None

@@ -17,7 +17,7 @@ standard errors, `pushjax.paper.statistics`). Besides ``rows``:
   ("train": the model's own training examples, or "validation"), "trans_percent", "rot_percent"}, ...]
   (`pushjax.train.curves`; a dataset without a validation split gives the training curve only);
 * ``provenance``: {"commit": the git commit of the code (with ``+changes`` when the tree differed from it; absent
-  when unknown, e.g. for an installed pushjax, `pushjax.paper.paths.git_commit`),
+  when unknown, e.g. for an installed pushjax, `pushjax.provenance.git_commit`),
   "invocations": [{"commit", "started" (UTC, ISO 8601), "wall_s", "finished"}, ...] every call of `run` on this
   work directory, a resumed one included, "wall_s": their sum}. A call is recorded in
   ``<workdir>/invocations.jsonl`` when it starts and brought up to date after every sweep, so a call that was
@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from pushjax import data
+from pushjax import provenance as provenance_lib
 from pushjax import train as train_lib
 from pushjax.paper import baselines as baselines_lib, paths
 from pushjax.paper.spec import ExperimentSpec
@@ -230,7 +231,7 @@ def _curve_rows(sweep: TrainedSweep, workdir: Path) -> list[dict]:
 def _record_sitting(workdir: Path, provenance: Mapping[str, str], started: datetime.datetime, wall_s: float,
                     finished: bool) -> dict:
     """Writes this call of `run` (of the code `provenance` names: its commit and, for changed code, the diff beside
-    the results, `pushjax.paper.paths.write_source_diff`) into ``<workdir>/invocations.jsonl``, replacing its earlier
+    the results, `pushjax.provenance.write_source_diff`) into ``<workdir>/invocations.jsonl``, replacing its earlier
     record, and returns the provenance of ``results.json``: every call's record and their wall time."""
     workdir.mkdir(parents=True, exist_ok=True)
     log = workdir / "invocations.jsonl"
@@ -269,7 +270,7 @@ def run(spec: ExperimentSpec, workdir: str | os.PathLike, progress: bool = True)
     workdir = Path(workdir)
     started, clock = datetime.datetime.now(datetime.timezone.utc), time.monotonic()
     writer = train_lib.distributed.is_writer()
-    provenance = paths.write_source_diff(workdir, paths.source_state()) if writer else {}
+    provenance = provenance_lib.write_source_diff(workdir, provenance_lib.source_state()) if writer else {}
 
     def record_sitting(finished: bool = False) -> dict | None:
         return _record_sitting(workdir, provenance, started, time.monotonic() - clock, finished) if writer else None

@@ -4,7 +4,7 @@ import subprocess
 
 import pytest
 
-from pushjax.paper import paths
+from pushjax import provenance
 
 
 def _git(root, *arguments):
@@ -28,31 +28,31 @@ def checkout(tmp_path):
 def test_results_do_not_dirty_the_code_and_changed_code_is_kept(checkout, tmp_path):
     commit = _git(checkout, "rev-parse", "HEAD").strip()
     (checkout / "results" / "record.json").write_text('{"changed": true}\n')  # a run's own output
-    state = paths.source_state(checkout)
+    state = provenance.source_state(checkout)
     assert state == {"commit": commit, "clean": True, "diff": ""}
-    assert paths.git_commit(checkout) == commit
-    assert paths.write_source_diff(tmp_path / "run", state) == {"commit": commit}
+    assert provenance.git_commit(checkout) == commit
+    assert provenance.write_source_diff(tmp_path / "run", state) == {"commit": commit}
     assert not (tmp_path / "run").exists()
 
     (checkout / "pushjax" / "model.py").write_text("WIDTH = 128\n")
     (checkout / "pushjax" / "new_head.py").write_text("DEPTH = 3\n")  # untracked code counts too
-    state = paths.source_state(checkout)
-    assert not state["clean"] and paths.git_commit(checkout) == commit + "+changes"
+    state = provenance.source_state(checkout)
+    assert not state["clean"] and provenance.git_commit(checkout) == commit + "+changes"
     assert "-WIDTH = 64" in state["diff"] and "+WIDTH = 128" in state["diff"]
     assert "+++ b/pushjax/new_head.py (untracked)" in state["diff"] and "+DEPTH = 3" in state["diff"]
-    provenance = paths.write_source_diff(tmp_path / "run", state)
-    assert provenance["commit"] == commit + "+changes"
-    assert (tmp_path / "run" / provenance["source_diff"]).read_text() == state["diff"]
-    assert paths.write_source_diff(tmp_path / "run", state) == provenance  # the same diff: one file
-    assert len(list((tmp_path / "run" / paths.PROVENANCE_DIR).iterdir())) == 1
+    recorded = provenance.write_source_diff(tmp_path / "run", state)
+    assert recorded["commit"] == commit + "+changes"
+    assert (tmp_path / "run" / recorded["source_diff"]).read_text() == state["diff"]
+    assert provenance.write_source_diff(tmp_path / "run", state) == recorded  # the same diff: one file
+    assert len(list((tmp_path / "run" / provenance.PROVENANCE_DIR).iterdir())) == 1
     # The diff applies to the commit and gives the code back.
     _git(checkout, "stash", "-q", "--include-untracked")
-    tracked = (tmp_path / "run" / provenance["source_diff"]).read_text().split("--- /dev/null")[0]
+    tracked = (tmp_path / "run" / recorded["source_diff"]).read_text().split("--- /dev/null")[0]
     (tmp_path / "tracked.diff").write_text(tracked)
     _git(checkout, "apply", str(tmp_path / "tracked.diff"))
     assert (checkout / "pushjax" / "model.py").read_text() == "WIDTH = 128\n"
 
 
 def test_no_checkout_no_provenance(tmp_path):
-    assert paths.source_state(tmp_path) is None and paths.git_commit(tmp_path) is None
-    assert paths.write_source_diff(tmp_path, None) == {}
+    assert provenance.source_state(tmp_path) is None and provenance.git_commit(tmp_path) is None
+    assert provenance.write_source_diff(tmp_path, None) == {}
