@@ -19,12 +19,12 @@ import math
 from absl import app, flags
 
 import experiments
-from pushjax.studies import adapt
+from pushjax.studies import adapt, worlds
 
 _WORKDIR = flags.DEFINE_string("workdir", None, "Folder for results.json, results.md, the figure, the pushes and the "
                                "loop's reports.", required=True)
 _SCALE = flags.DEFINE_enum("scale", "cpu", list(adapt.SCALES), "Effects, worlds, blocks and settings (smoke: a test).")
-_EFFECT = flags.DEFINE_string("effect", None, f"The world's undeclared effect, one of {','.join(adapt.EFFECTS)} "
+_EFFECT = flags.DEFINE_string("effect", None, f"The world's undeclared effect, one of {','.join(worlds.EFFECTS)} "
                               "(default: the scale's).")
 _WORLDS = flags.DEFINE_integer("worlds", None, "World seeds per effect (default: the scale's).")
 _BLOCKS = flags.DEFINE_integer("blocks", None, "Blocks of episodes per world (default: the scale's).")
@@ -37,9 +37,9 @@ _SEED = flags.DEFINE_integer("seed", None, "The first world seed (default: the s
 experiments.require_writable_folder("workdir")
 
 
-@flags.validator("effect", f"expected one of {','.join(adapt.EFFECTS)}")
+@flags.validator("effect", f"expected one of {','.join(worlds.EFFECTS)}")
 def _check_effect(value):
-    return value is None or value in adapt.EFFECTS
+    return value is None or value in worlds.EFFECTS
 
 
 for _name in ("worlds", "blocks", "per_block", "first_block"):

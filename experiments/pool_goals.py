@@ -4,8 +4,8 @@ r"""Push-to-goal runs in several worlds as one comparison: every goal of every w
 
 Each DIR is the ``--workdir`` of an ``experiments.push_to_goal`` run in its own world (``--seed``: its goals and
 testbed draws) with the same models and time limit; writes ``results.json``, ``results.md`` and ``trajectories.png``
-to OUT (``pushjax.control.report.pool_worlds``: the goals of all worlds the unit of the comparisons, decided by the
-project's rule). The runs' folders are only read.
+to OUT (``pushjax.studies.push_to_goal.pool_worlds``: the goals of all worlds the unit of the comparisons, decided by
+the project's rule). The runs' folders are only read.
 """
 
 import json
@@ -14,7 +14,7 @@ from pathlib import Path
 from absl import app, flags
 
 import experiments
-from pushjax.control import report
+from pushjax.studies import push_to_goal
 
 _RUNS = flags.DEFINE_list("runs", None, "Work folders of push_to_goal runs, one per world.", required=True)
 _WORKDIR = flags.DEFINE_string("workdir", None, "Folder for the pooled results.json, results.md and figure.",
@@ -33,10 +33,10 @@ def main(argv):
         except (OSError, ValueError) as error:
             raise app.UsageError(f"--runs: {path}: expected a push_to_goal results.json ({error})") from None
     try:
-        pooled = report.pool_worlds(runs)
+        pooled = push_to_goal.pool_worlds(runs)
     except (KeyError, ValueError) as error:
         raise app.UsageError(f"--runs: {error}") from None
-    paths = report.write(pooled, _WORKDIR.value)
+    paths = push_to_goal.write(pooled, _WORKDIR.value)
     print(paths[1].read_text())
     print(f"wrote {', '.join(str(path) for path in paths)}")
 

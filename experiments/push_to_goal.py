@@ -8,16 +8,16 @@ r"""Push objects to goal poses with model-predictive control, closed on the MuJo
       [--states=mocap,mocap+perception,perception --perception=<a trained model's work directory or checkpoint>
        [--perception_scale=cpu] [--perception_every=1] [--perception_gate=13.8]] [--looks=1]
 
-Draws the goals (``pushjax.control.goals``), runs every model and planner on each (``pushjax.control.push_to_goal``,
+Draws the goals (``pushjax.control.goals``), runs every model and planner on each (``pushjax.studies.push_to_goal``,
 resumable from ``--workdir``/episodes.jsonl) and writes ``results.json``, ``results.md`` and ``trajectories.png``.
 
-``--states`` chooses where the controller's state comes from (``pushjax.control.closed_loop.STATE_SOURCES``): motion
+``--states`` chooses where the controller's state comes from (``pushjax.studies.episode.STATE_SOURCES``): motion
 capture, motion capture and perception, perception only. Perception is the ``--perception`` model's (a hybrid trained
 on the ``data_efficiency`` dataset at ``--perception_scale``): the centre of mass it locates in the depth image of the
 true scene, rendered as its dataset renders examples, every ``--perception_every`` control periods
 (``pushjax.sensing.perception``), a reading skipped when ``--perception_gate`` is given and its squared innovation
-exceeds it (``pushjax.control.closed_loop.PositionSource.gate``); its noise is estimated on one push per object simulated with seed ``--seed`` + 1
-(``pushjax.filter.tracking.simulate_pushes``), not on the evaluated episodes.
+exceeds it (``pushjax.studies.episode.PositionSource.gate``); its noise is estimated on one push per object simulated with seed ``--seed`` + 1
+(``pushjax.studies.tracking.simulate_pushes``), not on the evaluated episodes.
 
 ``--looks`` says how many times the models' comparison has been looked at, this run included (e.g. 2 when more goals
 are added to a finished run in the same work folder): the verdict then needs Pocock's larger bound
@@ -30,13 +30,13 @@ from absl import app, flags
 
 import experiments
 from pushjax import stats
-from pushjax.control import closed_loop, mpc, push_to_goal, report
+from pushjax.control import mpc
 from pushjax.data import configs as data_configs
-from pushjax.filter import tracking
 from pushjax.geometry.objects import OBJECT_NAMES
 from pushjax.sensing import perception
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
+from pushjax.studies import episode, push_to_goal, tracking
 
 _WORKDIR = flags.DEFINE_string("workdir", None, "Folder for episodes.jsonl, results.json, results.md, the figure.",
                                required=True)
@@ -55,7 +55,7 @@ _TESTBED_OVERRIDES = flags.DEFINE_string("testbed_overrides", "", "Testbed magni
 _EFFECTS = flags.DEFINE_string("effects", "", "Effects of the simulated world, e.g. 'table_tilt_deg=2'.")
 _MAX_TIME = flags.DEFINE_float("max_time", None, "Simulated seconds per goal (default: the scale's).", lower_bound=1)
 _STATES = flags.DEFINE_list("states", ["mocap"], "The controller's state sources from "
-                            f"{','.join(closed_loop.STATE_SOURCES)} (perception: needs --perception).")
+                            f"{','.join(episode.STATE_SOURCES)} (perception: needs --perception).")
 _PERCEPTION = flags.DEFINE_string("perception", None, "A trained model's work directory or checkpoint "
                                   "(pushjax.train.predictor.load_model; its last model) whose perception reads the "
                                   "object's position from the rendered depth image.")
@@ -121,8 +121,8 @@ flags.register_multi_flags_validator(
 flags.register_validator("effect_params", _parsed_by(push_to_goal.parse_effect_params))
 flags.register_validator(
     "states", lambda values: bool(values) and len(set(values)) == len(values)
-    and set(values) <= set(closed_loop.STATE_SOURCES),
-    f"expected a non-empty list from {','.join(closed_loop.STATE_SOURCES)}, no repeats")
+    and set(values) <= set(episode.STATE_SOURCES),
+    f"expected a non-empty list from {','.join(episode.STATE_SOURCES)}, no repeats")
 flags.register_multi_flags_validator(
     ["states", "perception"], lambda values: any("perception" in state for state in values["states"])
     == bool(values["perception"]), "--perception: expected exactly when --states has a state with perception")
@@ -134,7 +134,7 @@ def main(argv):
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
     testbed = experiments.testbed_from_flags(_TESTBED.value, _TESTBED_OVERRIDES.value)
     scale = push_to_goal.SCALES[_SCALE.value]
-    loop = closed_loop.LoopConfig(max_time=_MAX_TIME.value or scale["max_time"], surface=_SURFACE.value,
+    setup = episode.EpisodeConfig(max_time=_MAX_TIME.value or scale["max_time"], surface=_SURFACE.value,
                                   testbed=testbed, effects=Effects.parse(_EFFECTS.value))
     objects = _OBJECTS.value or scale["objects"]
     for name in ("perception_scale", "perception_every", "perception_gate"):
@@ -150,20 +150,20 @@ def main(argv):
         noise_seed = _SEED.value + tracking.TRAINING_SEED_OFFSET
         noise_pushes = tracking.simulate_pushes(objects, NOISE_PUSHES, noise_seed, testbed, 1.0 / period)
         noise = perception.estimate_noise(sensor, noise_pushes, _PERCEPTION_EVERY.value)
-        position = closed_loop.PositionSource(sensor.locate, tuple(max(v, 1e-5) for v in noise["std"]),
-                                              _PERCEPTION_EVERY.value, sensor.description, _PERCEPTION_GATE.value)
+        position = episode.PositionSource(sensor.locate, tuple(max(v, 1e-5) for v in noise["std"]),
+                                          _PERCEPTION_EVERY.value, sensor.description, _PERCEPTION_GATE.value)
         position_settings = {"model": _PERCEPTION.value, "dataset": f"data_efficiency/{_PERCEPTION_SCALE.value}",
                              "noise_seed": noise_seed, "noise_bias_m": noise["bias"], "noise_rmse_m": noise["rmse"],
                              "noise_readings": noise["readings"], "noise_pushes": noise["pushes"]}
     try:
         results = push_to_goal.run(_WORKDIR.value, objects, _GOALS.value or scale["goals"], _MODELS.value,
-                                   _PLANNERS.value or scale["planners"], _SEED.value, loop, _EFFECT_PARAMS.value,
+                                   _PLANNERS.value or scale["planners"], _SEED.value, setup, _EFFECT_PARAMS.value,
                                    scale["controller"], _LOOP_MODEL.value, _STATES.value, position, position_settings,
                                    _LOOKS.value)
     except push_to_goal.ModelFileError as error:
         raise app.UsageError(f"--loop_model: {error}") from None
     results["settings"]["scale"] = _SCALE.value
-    paths = report.write(results, _WORKDIR.value)
+    paths = push_to_goal.write(results, _WORKDIR.value)
     print(paths[1].read_text())
     print(f"wrote {', '.join(str(path) for path in paths)}")
 

@@ -4,7 +4,7 @@ r"""Track pushes of the testbed with the EKF, UKF and particle filter, and infer
       [--seed=0 | --seeds=1,2,3] [--rate_hz=10] [--learn_steps=200] [--testbed=realistic|ideal] [--testbed_overrides='drop_rate=0.1']
       [--perception=<a trained model's work directory or checkpoint> [--perception_hz=2.5] [--perception_scale=cpu]]
 
-Simulates the scale's pushes in memory (``pushjax.filter.tracking``: the truth only the simulation knows), filters
+Simulates the scale's pushes in memory (``pushjax.studies.tracking``: the truth only the simulation knows), filters
 the tracked poses, and writes ``results.json``, ``results.md`` (pose RMSE against the raw measurements and a
 constant-velocity filter, NEES in its 95 % band, the pusher friction against its drawn value, the hand-set and the
 learned noise) and ``mu_over_time.png`` to ``--workdir``. ``ekf_learned`` learns its noise on as many other pushes,
@@ -19,7 +19,7 @@ readings themselves). The model's folder is only read.
 
 ``--seeds=1,2,3`` runs each seed into ``--workdir/seed<k>/`` (a seed whose ``results.json`` is there is read, not run
 again) and writes to ``--workdir`` the filters' position errors per seed and their paired comparisons over the pushes
-of every seed but the one the process noise was tuned on (``pushjax.filter.tracking.compare_over_seeds``).
+of every seed but the one the process noise was tuned on (``pushjax.studies.tracking.compare_over_seeds``).
 """
 
 import json
@@ -31,8 +31,8 @@ from absl import app, flags
 import experiments
 from pushjax.data import configs as data_configs
 from pushjax import outputs
-from pushjax.filter import tracking
 from pushjax.sensing import perception
+from pushjax.studies import tracking
 
 _WORKDIR = flags.DEFINE_string("workdir", None, "Folder for results.json, results.md and the figure.", required=True)
 _SCALE = flags.DEFINE_enum("scale", "cpu", list(tracking.SCALES), "Objects, pushes and particles (smoke: a test).")
@@ -139,7 +139,7 @@ def main(argv):
 
 
 def _run_seed(seed: int, testbed, rate: float, sensor, every: int) -> dict:
-    """The results of :func:`pushjax.filter.tracking.run` on the pushes of `seed` at the flags' scale and filters."""
+    """The results of :func:`pushjax.studies.tracking.run` on the pushes of `seed` at the flags' scale and filters."""
     scale = tracking.SCALES[_SCALE.value]
     learns = "ekf_learned" in _FILTERS.value
     pushes = tracking.simulate_pushes(scale["objects"], scale["pushes"], seed, testbed, rate)

@@ -75,8 +75,8 @@ DECISION_STANDARD_ERRORS = 2.0
 comparison when it lies more than this many of its standard errors from zero (`decide`). The standard error is
 that of the *paired* difference, and each caller names its unit of resampling: push sequences of a test split (with
 the spread over world seeds where several were trained: `pushjax.paper.statistics`) for the paper's findings and
-the rollouts' expectations; goals for the push-to-goal comparisons (`pushjax.control.report.compare`). At one look
-this is the two-sided 5 % level of a normal difference (1.96), rounded up."""
+the rollouts' expectations; goals for the push-to-goal comparisons (`pushjax.studies.push_to_goal.compare`). At one
+look this is the two-sided 5 % level of a normal difference (1.96), rounded up."""
 
 SEQUENTIAL_STANDARD_ERRORS = {1: DECISION_STANDARD_ERRORS, 2: 2.178, 3: 2.289, 4: 2.361, 5: 2.413}
 """looks -> the bound of `decide` when the same comparison is looked at that many times as its data grow (equally

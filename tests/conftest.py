@@ -38,7 +38,7 @@ def pytest_configure(config):
     for every pytest-xdist worker (in pytest's cache folder), set before anything compiles: the loop's data sets compile the same fitting programs, the exact limit surface's in 10-20 s
     each, and without the cache every data set compiles them again. The tests' subprocesses (binaries, notebook
     kernels) get it through the environment, e.g. ``experiments.push_to_goal --scale=smoke`` the controller programs
-    that tests/control/test_closed_loop.py compiles."""
+    that tests/studies/test_episode.py compiles."""
     _use_fast_compile_flag()
     if getattr(config, "cache", None) is None:
         return

@@ -27,7 +27,7 @@ HELP_TEXT = re.compile(r"^\s+--\[?\w|^flags:|^\s+\(default: |Try --help")
 
 LIBRARIES = ("experiments, pushjax.data, pushjax.loop, pushjax.paper.findings, pushjax.paper.figures, "
              "pushjax.paper.rollouts, pushjax.paper.runner, pushjax.paper.spec, pushjax.paper.tables, "
-             "pushjax.paper.visualize, pushjax.physics.demo, pushjax.sim.dataset, pushjax.control.push_to_goal, "
+             "pushjax.paper.visualize, pushjax.physics.demo, pushjax.sim.dataset, pushjax.studies.push_to_goal, "
              "pushjax.studies.adapt")
 """What the binaries import, bar the binaries themselves (each defines flags): a server imports it once and forks."""
 

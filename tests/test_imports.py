@@ -20,6 +20,23 @@ def test_pure_packages_do_not_import_mujoco(module):
     assert result.returncode == 0, result.stderr[-3000:]
 
 
+ALGORITHM_PACKAGES = ("pushjax.filter", "pushjax.control")
+"""The packages that keep the algorithms only: their harnesses on the testbed are studies (``pushjax.studies``)."""
+
+
+@pytest.mark.parametrize("package", ALGORITHM_PACKAGES)
+def test_algorithm_packages_import_neither_mujoco_nor_the_testbed(package):
+    folder = PACKAGE / package.removeprefix("pushjax.")
+    modules = [package] + [f"{package}.{path.stem}" for path in sorted(folder.glob("*.py")) if path.stem != "__init__"]
+    assert len(modules) > 5
+    script = (f"import sys; import {', '.join(modules)}; "
+              "found = sorted(name for name in sys.modules if name.split('.')[0] == 'mujoco' "
+              "or name.startswith(('pushjax.sim', 'pushjax.studies'))); assert not found, found")
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                            env={**os.environ, "MUJOCO_GL": "egl"})
+    assert result.returncode == 0, result.stderr[-3000:]
+
+
 def _indented_imports(tree: ast.Module) -> list[int]:
     """Line numbers of the import statements that are not at the module's top level (inside a function, class,
     ``if`` or ``try``)."""

@@ -18,7 +18,7 @@ import jax.numpy as jnp
 
 from pushjax.control import cost as cost_lib
 from pushjax.control import path as path_lib
-from pushjax.control.model import PushModel
+from pushjax.control.model import PlanningModel
 from pushjax.geometry import outline_jax
 
 __all__ = ["approach_points", "candidates", "clearance_radius", "detour", "rotate", "score_candidates"]
@@ -50,12 +50,12 @@ def approach_points(shape: outline_jax.Outline, pose, points, normals, distance)
     return pose[:2] + rotate(points, pose[2]) - distance * world_normals, world_normals
 
 
-def score_candidates(model: PushModel, pose, goal, horizon: int, limit, weights: cost_lib.CostWeights, count: int,
+def score_candidates(model: PlanningModel, pose, goal, horizon: int, limit, weights: cost_lib.CostWeights, count: int,
                      directions: int, max_angle: float, standoff: float, lengths: tuple[int, ...]):
     """Costs of straight pushes from every candidate's approach point.
 
     Args:
-      model: the :class:`~pushjax.control.model.PushModel`.
+      model: the :class:`~pushjax.control.model.PlanningModel`.
       pose: [3] object pose (x m, y m, yaw rad).
       goal: [3] goal pose.
       horizon: steps of each push.

@@ -13,7 +13,7 @@ import flax.struct
 import jax.numpy as jnp
 
 from pushjax.control import path as path_lib
-from pushjax.control.model import PushModel, predict
+from pushjax.control.model import PlanningModel, predict
 
 __all__ = ["CostWeights", "plan_cost", "pose_error", "trajectory_cost", "wrap"]
 
@@ -72,7 +72,7 @@ def trajectory_cost(poses, steps, goal, limit, weights: CostWeights):
     return cost, {"terminal": terminal, "running": running, "effort": effort}
 
 
-def plan_cost(model: PushModel, pose, goal, start, raw, limit, weights: CostWeights):
+def plan_cost(model: PlanningModel, pose, goal, start, raw, limit, weights: CostWeights):
     """(cost [], metrics) of the plan `raw` [H, 2] (:mod:`pushjax.control.path`) from the pusher at `start` [2]
     (world, m) and the object at `pose` [3], predicted by `model`."""
     path = path_lib.pusher_path(start, raw, limit)

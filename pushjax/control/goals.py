@@ -5,9 +5,9 @@ A goal moves the object from its start pose, the origin at yaw 0, by a translati
 from ``default_rng([seed, crc32(object)])``: the same seed gives every object the same goals whatever else is run.
 Success is a final TRUE pose within :data:`SUCCESS_POSITION` and :data:`SUCCESS_YAW_DEG` of the goal; success rates
 come with Wilson score intervals (:func:`wilson_interval`). When one model pushes better than another is decided by
-the project's one rule (:func:`pushjax.stats.decide`, in :func:`pushjax.control.report.compare`): over the goals both
-were given (same object, goal and planner; the goals are the unit), the mean paired difference of the time to
-success, a failed goal counting as the episode's time limit, below zero by more than 2 standard errors of that mean
+the project's one rule (:func:`pushjax.stats.decide`, in :func:`pushjax.studies.push_to_goal.compare`): over the
+goals both were given (same object, goal and planner; the goals are the unit), the mean paired difference of the time
+to success, a failed goal counting as the episode's time limit, below zero by more than 2 standard errors of that mean
 (Pocock's larger bound when the same comparison is looked at again with more goals); above zero by as much: worse;
 in between: not decided with that many goals.
 """

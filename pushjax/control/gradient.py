@@ -14,7 +14,7 @@ import jax.numpy as jnp
 import optax
 
 from pushjax.control import cost as cost_lib
-from pushjax.control.model import PushModel
+from pushjax.control.model import PlanningModel
 
 __all__ = ["GradientConfig", "plan"]
 
@@ -32,12 +32,12 @@ class GradientConfig:
     learning_rate: float = flax.struct.field(pytree_node=False, default=0.1)
 
 
-def plan(model: PushModel, pose, goal, start, raw, limit, weights: cost_lib.CostWeights, config: GradientConfig,
+def plan(model: PlanningModel, pose, goal, start, raw, limit, weights: cost_lib.CostWeights, config: GradientConfig,
          key=None):
     """The best plan found by Adam from the initial plan `raw` [H, 2].
 
     Args:
-      model: the :class:`~pushjax.control.model.PushModel`.
+      model: the :class:`~pushjax.control.model.PlanningModel`.
       pose: [3] object pose now (x m, y m, yaw rad).
       goal: [3] goal pose.
       start: [2] pusher position now, world, m.

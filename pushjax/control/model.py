@@ -1,6 +1,6 @@
 """The pushing model a controller plans with: an object's outline and Lynch's model with any composed effects.
 
-:class:`PushModel` is a pytree (``effects`` static), so a controller jit-compiled once per set of effect names
+:class:`PlanningModel` is a pytree (``effects`` static), so a controller jit-compiled once per set of effect names
 takes any object, ``l``, ``mu`` and effect parameters without compiling again. :func:`predict` is the rollout of
 :mod:`pushjax.physics.rollout` along a pusher path.
 """
@@ -19,11 +19,11 @@ from pushjax.physics import effects as effects_lib
 from pushjax.physics import model_file
 from pushjax.physics import rollout
 
-__all__ = ["PushModel", "make_model", "predict"]
+__all__ = ["PlanningModel", "make_model", "predict"]
 
 
 @flax.struct.dataclass
-class PushModel:
+class PlanningModel:
     """One object and the pushing model the controller believes in.
 
     Attributes:
@@ -50,8 +50,8 @@ class PushModel:
 
 
 def make_model(obj: PushObject | str, mu: float = 0.25, l: float | None = None, *, effects: Sequence[str] = (),
-               params: dict | None = None, dtype=jnp.float32) -> PushModel:
-    """The :class:`PushModel` of `obj` (or its name).
+               params: dict | None = None, dtype=jnp.float32) -> PlanningModel:
+    """The :class:`PlanningModel` of `obj` (or its name).
 
     Args:
       obj: the object.
@@ -68,13 +68,13 @@ def make_model(obj: PushObject | str, mu: float = 0.25, l: float | None = None, 
     effects = tuple(effects)
     full = model_file.AugmentedModel.create(effects, params, mu).params  # filled up and checked
     full = jax.tree_util.tree_map(lambda value: jnp.asarray(value, dtype), full)
-    return PushModel(shape=outline_jax.outline(obj, dtype), l=jnp.asarray(l, dtype), mu=jnp.asarray(mu, dtype),
+    return PlanningModel(shape=outline_jax.outline(obj, dtype), l=jnp.asarray(l, dtype), mu=jnp.asarray(mu, dtype),
                      radius=jnp.asarray(PUSHER_RADIUS, dtype), params=full,
                      support=rollout.object_support(obj, dtype) if effects_lib.needs_support(effects) else None,
                      effects=effects)
 
 
-def predict(model: PushModel, pose, pusher_path) -> rollout.Rollout:
+def predict(model: PlanningModel, pose, pusher_path) -> rollout.Rollout:
     """The model's rollout from `pose` [3] (x m, y m, yaw rad) along `pusher_path` [T + 1, 2] (world, m)."""
     return rollout.rollout(model.shape, pose, pusher_path, model.l, model.mu, model.params, effects=model.effects,
                            radius=model.radius, support=model.support, search=model.search)

@@ -3,21 +3,25 @@
 Every :func:`replan` (one jit-compiled call per configuration and set of effect names) does three things with the
 observed object pose, the pusher's position and the goal:
 
-1. plans from where the pusher is: the planner of :attr:`ControllerConfig.planner` (``"gradient"``:
-   :mod:`pushjax.control.gradient`, ``"sampling"``: :mod:`pushjax.control.sampling`), warm-started from the last
-   plan advanced by the executed steps;
+1. plans from where the pusher is: the planner of :data:`PLANNERS` named by :attr:`ControllerConfig.planner`
+   (``"gradient"``: :mod:`pushjax.control.gradient`, ``"sampling"``: :mod:`pushjax.control.sampling`), warm-started
+   from the last plan advanced by the executed steps;
 2. scores every candidate contact around the outline (:func:`pushjax.control.contact.score_candidates`);
 3. decides to reposition when the best candidate beats the plan from here by the factor ``switch_ratio``, or when
    the plan from here is no better than standing still (the pusher has lost the object or cannot move it towards
    the goal from this side) and the candidate is. A reposition returns the detour's waypoints and sets the plan to the candidate's
    straight push, which the next call refines.
 
-Every plan respects the speed limit by construction (:mod:`pushjax.control.path`).
+Every plan respects the speed limit by construction (:mod:`pushjax.control.path`). The module is a
+:class:`pushjax.control.controller.Controller`: :func:`init` and :func:`replan`, whose answer is a
+:class:`~pushjax.control.controller.Command`.
 """
 
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
+from typing import NamedTuple
 
 import flax.struct
 import jax
@@ -26,12 +30,26 @@ import jax.numpy as jnp
 from pushjax.control import contact, gradient, sampling
 from pushjax.control import cost as cost_lib
 from pushjax.control import path as path_lib
-from pushjax.control.model import PushModel, predict
+from pushjax.control.controller import Command
+from pushjax.control.model import PlanningModel, predict
 
-__all__ = ["PLANNERS", "ControllerConfig", "ControllerState", "Decision", "init", "replan"]
+__all__ = ["PLANNERS", "ControllerConfig", "ControllerState", "Planner", "init", "replan"]
 
-PLANNERS = {"gradient": gradient.plan, "sampling": sampling.plan}
-"""The planners by name: ``(model, pose, goal, start, raw, limit, weights, config, key) -> (raw, cost)``."""
+
+class Planner(NamedTuple):
+    """A planner of :data:`PLANNERS`.
+
+    Attributes:
+      plan: ``(model, pose, goal, start, raw, limit, weights, settings, key) -> (raw, cost)``.
+      settings: the :class:`ControllerConfig` field that holds its settings.
+    """
+
+    plan: Callable
+    settings: str
+
+
+PLANNERS = {"gradient": Planner(gradient.plan, "gradient"), "sampling": Planner(sampling.plan, "sampling")}
+"""The planners by name, the one place a planner is chosen (:attr:`ControllerConfig.planner`)."""
 
 
 @flax.struct.dataclass
@@ -39,7 +57,7 @@ class ControllerConfig:
     """Static settings of the controller (hashable: one compilation per configuration).
 
     Attributes:
-      planner: ``"gradient"`` or ``"sampling"``.
+      planner: a name of :data:`PLANNERS`.
       horizon: steps planned ahead.
       period: duration of one step, s.
       speed_limit: the pusher's largest speed, m/s.
@@ -100,8 +118,8 @@ class ControllerConfig:
 
     @property
     def planner_config(self):
-        """The chosen planner's settings."""
-        return self.gradient if self.planner == "gradient" else self.sampling
+        """The chosen planner's settings (its :attr:`Planner.settings` field)."""
+        return getattr(self, PLANNERS[self.planner].settings)
 
 
 @flax.struct.dataclass
@@ -117,49 +135,26 @@ class ControllerState:
     key: jax.Array
 
 
-@flax.struct.dataclass
-class Decision:
-    """One :func:`replan`'s answer.
-
-    Attributes:
-      reposition: [] bool, go around the object to ``waypoints[-1]`` before pushing on.
-      increments: [H, 2] the plan's pusher increments, world, m (from the approach point after a reposition).
-      waypoints: [W, 2] the detour, world, m (meaningful when ``reposition``).
-      predicted: [H + 1, 3] the object poses the plan predicts.
-      cost: [] the plan's cost.
-      idle_cost: [] the cost of standing still.
-      candidate_cost: [] the best candidate's cost.
-    """
-
-    reposition: jax.Array
-    increments: jax.Array
-    waypoints: jax.Array
-    predicted: jax.Array
-    cost: jax.Array
-    idle_cost: jax.Array
-    candidate_cost: jax.Array
-
-
 def init(config: ControllerConfig, key, dtype=jnp.float32) -> ControllerState:
     """The state before the first plan: a plan of standing still."""
     return ControllerState(raw=jnp.zeros((config.horizon, 2), dtype), key=key)
 
 
 @functools.partial(jax.jit, static_argnames=("config",))
-def replan(config: ControllerConfig, model: PushModel, state: ControllerState, pose, pusher, goal):
+def replan(config: ControllerConfig, model: PlanningModel, state: ControllerState, pose, pusher, goal):
     """Plans from the observed `pose` [3] (x m, y m, yaw rad) and the pusher at `pusher` [2] (world, m) towards
     `goal` [3].
 
     Returns:
       (the :class:`ControllerState` to pass to the next call after executing ``config.replan_steps`` steps, the
-      :class:`Decision`).
+      :class:`~pushjax.control.controller.Command`).
     """
     pose, pusher, goal = (jnp.asarray(value, state.raw.dtype) for value in (pose, pusher, goal))
     limit = jnp.asarray(config.limit, state.raw.dtype)
     key, plan_key = jax.random.split(state.key)
     idle_cost, _ = cost_lib.plan_cost(model, pose, goal, pusher, jnp.zeros_like(state.raw), limit, config.weights)
-    raw, plan_cost = PLANNERS[config.planner](model, pose, goal, pusher, state.raw, limit, config.weights,
-                                              config.planner_config, plan_key)
+    raw, plan_cost = PLANNERS[config.planner].plan(model, pose, goal, pusher, state.raw, limit, config.weights,
+                                                   config.planner_config, plan_key)
     costs, approach, normals, plans = contact.score_candidates(
         model, pose, goal, config.horizon, limit, config.weights, config.candidates, config.directions,
         config.max_angle, config.standoff, config.push_lengths)
@@ -173,9 +168,9 @@ def replan(config: ControllerConfig, model: PushModel, state: ControllerState, p
     raw = jnp.where(reposition, plans[candidate, direction], raw)
     start = jnp.where(reposition, approach[candidate], pusher)
     path = path_lib.pusher_path(start, raw, limit)
-    decision = Decision(reposition=reposition, increments=jnp.diff(path, axis=0), waypoints=waypoints,
-                        predicted=predict(model, pose, path).poses,
-                        cost=jnp.where(reposition, candidate_cost, plan_cost), idle_cost=idle_cost,
-                        candidate_cost=candidate_cost)
+    command = Command(reposition=reposition, increments=jnp.diff(path, axis=0), waypoints=waypoints,
+                      predicted=predict(model, pose, path).poses,
+                      cost=jnp.where(reposition, candidate_cost, plan_cost), idle_cost=idle_cost,
+                      candidate_cost=candidate_cost)
     advanced = jnp.where(reposition, raw, path_lib.shifted(raw, config.replan_steps))
-    return ControllerState(raw=advanced, key=key), decision
+    return ControllerState(raw=advanced, key=key), command

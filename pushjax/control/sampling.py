@@ -13,7 +13,7 @@ import jax
 import jax.numpy as jnp
 
 from pushjax.control import cost as cost_lib
-from pushjax.control.model import PushModel
+from pushjax.control.model import PlanningModel
 
 __all__ = ["SamplingConfig", "plan"]
 
@@ -37,7 +37,7 @@ class SamplingConfig:
     min_std: float = flax.struct.field(pytree_node=False, default=0.05)
 
 
-def plan(model: PushModel, pose, goal, start, raw, limit, weights: cost_lib.CostWeights, config: SamplingConfig,
+def plan(model: PlanningModel, pose, goal, start, raw, limit, weights: cost_lib.CostWeights, config: SamplingConfig,
          key):
     """The cheapest plan the cross-entropy method finds around the initial plan `raw` [H, 2].
 

@@ -15,9 +15,9 @@ camera and image size are not stored with the model, and a model sees only what 
 Readings along pushes (:func:`readings`) are taken at every ``every``-th step of the filter clock, from the first,
 NaN between (rendering and the network cost more than a filter step); :func:`estimate_noise` gives the readings'
 noise from other pushes than the evaluated ones, :func:`stream` both as the filters' second observation stream
-(:class:`pushjax.filter.tracking.PositionStream`, :class:`pushjax.filter.models.PositionSensor`).
+(:class:`pushjax.filter.observations.PositionStream`, :class:`pushjax.filter.models.PositionSensor`).
 
-The controller (``pushjax.control.closed_loop``, issue 32) can take its state from the same sensor:
+The controller closed on the testbed (``pushjax.studies.episode``, issue 32) can take its state from the same sensor:
 :meth:`PerceptionSensor.locate` on the scene at the controller's period, and
 :func:`pushjax.filter.models.update_position` after the EKF's pose update there.
 
@@ -36,7 +36,7 @@ import numpy as np
 from pushjax import planar
 from pushjax.data.configs import DatasetConfig, get_config
 from pushjax.data.examples import make_renderer
-from pushjax.filter.tracking import PositionStream, TrackedPush
+from pushjax.filter.observations import PositionStream, TrackedPush
 from pushjax.geometry.objects import get_object, limit_surface_ratio
 from pushjax.render.renderer import DepthRenderer
 from pushjax.train.predictor import Predictor, load_model

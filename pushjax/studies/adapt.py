@@ -1,17 +1,10 @@
 """Learn while pushing: the controller closes the loop on the pushes it makes (``python -m experiments.adapt``).
 
-A **world** is the realistic testbed (:data:`pushjax.sim.testbed.REALISTIC`) with one effect the controller's model
-does not declare, its magnitude drawn from the world's seed (:func:`draw_world`, :data:`EFFECTS`):
+A **world** (:func:`pushjax.studies.worlds.draw_world`) is the realistic testbed with one effect the controller's model
+does not declare (:data:`pushjax.studies.worlds.EFFECTS`: ``tilt``, ``com_offset``, ``pusher_friction``,
+``friction_variability``), its magnitude drawn from the world's seed.
 
-``tilt``                  the table tilted by 2-4 degrees towards a uniform azimuth (``Effects.table_tilt_deg``);
-``com_offset``            the centre of mass moved by 30-50 % of the distance from the centroid to the outline, in a
-                          uniform direction (``Effects.com_offset``, object axes);
-``pusher_friction``       a pusher-object coefficient of 0.08-0.15 instead of the nominal 0.25
-                          (``Effects.pusher_friction``; the testbed still spreads it per push);
-``friction_variability``  the pusher-object coefficient spread from push to push by a log-normal factor of spread
-                          0.5-0.8 instead of the realistic profile's 0.2 (``Testbed.pusher_friction_sigma``).
-
-In each world the controller (:func:`pushjax.control.closed_loop.run_episode`: motion capture and the EKF) pushes
+In each world the controller (:func:`pushjax.studies.episode.run_episode`: motion capture and the EKF) pushes
 the objects to a sequence of ``first_block + (blocks - 1) * per_block`` goals (:func:`pushjax.control.goals.draw_goals`
 with the world's seed, the objects taking turns) three ways, the **arms** (:data:`ARMS`), on the same goals with the
 same testbed draws (paired by goal):
@@ -24,7 +17,7 @@ same testbed draws (paired by goal):
               :func:`pushjax.loop.splits.minimum_sequences` push sequences, one per episode) the controller plans with
               plain Lynch, and the reason is recorded;
 ``plain``     plain Lynch with the nominal pusher friction throughout (no adaptation);
-``oracle``    the model that knows the world's effect and magnitude (:meth:`World.oracle`): ``table_tilt`` with the
+``oracle``    the model that knows the world's effect and magnitude (``World.oracle``): ``table_tilt`` with the
               drift force ``tan(tilt) / mu_surface`` downhill, ``cof_offset`` at the moved centre of mass, the true
               pusher friction, or for the variability its mean ``0.25 exp(sigma^2 / 2)``.
 
@@ -34,8 +27,8 @@ episode instead of simulating it again.
 
 Per arm and block: the success rate (:func:`pushjax.control.goals.succeeded`: within 5 mm and 5 degrees), the time to
 goal (the simulated seconds of a success; a failure counts as ``max_time``, as in
-:func:`pushjax.control.report.compare`) and the pusher's path length; for ``adaptive`` what the loop selected after
-each block. The comparison rule, fixed before any run, is :data:`COMPARISON_RULE`.
+:func:`pushjax.studies.push_to_goal.compare`) and the pusher's path length; for ``adaptive`` what the loop selected
+after each block. The comparison rule, fixed before any run, is :data:`COMPARISON_RULE`.
 
 Outputs (:func:`write`): ``results.json``, ``results.md`` and ``time_to_goal.png`` in the work folder; below it
 ``<effect>/world=<seed>/pushes`` (the adaptive arm's push files) and ``<effect>/world=<seed>/loop/block=<b>`` (the
@@ -53,43 +46,32 @@ import math
 import os
 import shutil
 import time
-import zlib
 from collections.abc import Sequence
 from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
-import shapely
 import tqdm
 
 from pushjax import outputs, stats
-from pushjax.control import closed_loop, goals, gradient, mpc
+from pushjax.control import goals, gradient, mpc
 from pushjax.control.model import make_model
-from pushjax.geometry.objects import OBJECT_NAMES, get_object
+from pushjax.geometry.objects import OBJECT_NAMES
 from pushjax.loop import LoopSettings, close_loop
 from pushjax.loop.correction import CorrectionSettings
 from pushjax.loop.fit import FitSettings
 from pushjax.mit.files import PushParams, push_file_name, write_push
 from pushjax.physics.model_file import AugmentedModel
-from pushjax.sim.effects import Effects
-from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION, SURFACE_NAMES, get_surface
+from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION, SURFACE_NAMES
 from pushjax.sim.testbed import REALISTIC, Testbed
+from pushjax.studies import episode
+from pushjax.studies.worlds import EFFECTS, World, draw_world
 
-__all__ = ["ARMS", "AdaptConfig", "COMPARISON_RULE", "EFFECTS", "GAP_SHARE", "SCALES", "STANDARD_ERRORS", "World",
-           "compare", "draw_world", "episode_push_path", "make_config", "run", "write"]
+__all__ = ["ARMS", "AdaptConfig", "COMPARISON_RULE", "GAP_SHARE", "SCALES", "STANDARD_ERRORS", "compare",
+           "episode_push_path", "make_config", "run", "write"]
 
-EFFECTS = ("tilt", "com_offset", "pusher_friction", "friction_variability")
-"""The worlds' undeclared effects (see the module docstring)."""
 ARMS = ("adaptive", "plain", "oracle")
 """The controllers compared on every goal."""
-TILT_DEG = (2.0, 4.0)
-"""Range of the table's tilt, degrees (below the abs surface's friction angle of 7.4 degrees)."""
-COM_OFFSET_SHARE = (0.3, 0.5)
-"""Range of the centre of mass's offset, as a share of the distance from the centroid to the outline."""
-PUSHER_FRICTION = (0.08, 0.15)
-"""Range of the low pusher-object coefficient (nominal 0.25)."""
-FRICTION_SIGMA = (0.5, 0.8)
-"""Range of the push-to-push spread of the pusher-object coefficient (std of its log; realistic profile: 0.2)."""
 
 GAP_SHARE = 0.5
 """Share of the plain-oracle gap in time to goal that the adaptive controller must close."""
@@ -116,7 +98,7 @@ class AdaptConfig:
     """What a run of the study does.
 
     Attributes:
-      effects: the worlds' effects, from :data:`EFFECTS`, no repeats.
+      effects: the worlds' effects, from :data:`pushjax.studies.worlds.EFFECTS`, no repeats.
       objects: the pushed objects (taking turns through the goals), from ``OBJECT_NAMES``, no repeats.
       worlds: world seeds per effect: ``seed, seed + 1, ...``.
       blocks: blocks of episodes per world.
@@ -220,66 +202,6 @@ def make_config(scale: str, **overrides) -> AdaptConfig:
     return dataclasses.replace(SCALES[scale], **{key: value for key, value in overrides.items() if value is not None})
 
 
-@dataclasses.dataclass(frozen=True)
-class World:
-    """One world: an effect and its magnitude.
-
-    Attributes:
-      effect: from :data:`EFFECTS`.
-      seed: the world's seed (its magnitude, goals and testbed draws).
-      magnitude: the drawn magnitude in readable units (JSON-able; e.g. ``{"tilt_deg", "azimuth_deg"}``).
-      effects: {object: the testbed's :class:`pushjax.sim.effects.Effects`}.
-      testbed: the testbed profile.
-      oracle: {object: the model that knows the effect (:class:`pushjax.physics.model_file.AugmentedModel`)}.
-    """
-
-    effect: str
-    seed: int
-    magnitude: dict
-    effects: dict[str, Effects]
-    testbed: Testbed
-    oracle: dict[str, AugmentedModel]
-
-
-def draw_world(effect: str, seed: int, objects: Sequence[str], surface: str = "abs",
-               testbed: Testbed = REALISTIC) -> World:
-    """The world of `effect` with seed `seed`: its magnitude drawn from ``default_rng([seed, crc32(effect)])`` (see
-    the module docstring for the ranges), for `objects` on `surface`."""
-    if effect not in EFFECTS:
-        raise ValueError(f"effect: expected one of {','.join(EFFECTS)}, got {effect!r}")
-    rng = np.random.default_rng([seed, zlib.crc32(effect.encode("utf-8"))])
-    if effect == "tilt":
-        tilt, azimuth = rng.uniform(*TILT_DEG), rng.uniform(0.0, 360.0)
-        drift = math.tan(math.radians(tilt)) / get_surface(surface).object_friction
-        downhill = [drift * math.cos(math.radians(azimuth)), drift * math.sin(math.radians(azimuth))]
-        oracle = AugmentedModel.create(("table_tilt",), {"table_tilt": {"drift_force": downhill}},
-                                       PUSHER_OBJECT_FRICTION)
-        return World(effect, seed, {"tilt_deg": tilt, "azimuth_deg": azimuth, "drift_force": downhill},
-                     {obj: Effects(table_tilt_deg=tilt, table_tilt_azimuth_deg=azimuth) for obj in objects}, testbed,
-                     {obj: oracle for obj in objects})
-    if effect == "com_offset":
-        share, direction = rng.uniform(*COM_OFFSET_SHARE), rng.uniform(-math.pi, math.pi)
-        offsets = {}
-        for obj in objects:
-            shape = get_object(obj)
-            inside = shape.polygon.exterior.distance(shapely.Point(*shape.centroid))
-            offsets[obj] = [share * inside * math.cos(direction), share * inside * math.sin(direction)]
-        return World(effect, seed, {"share_of_inradius": share, "direction_deg": math.degrees(direction),
-                                    "offset_m": offsets},
-                     {obj: Effects(com_offset=offsets[obj]) for obj in objects}, testbed,
-                     {obj: AugmentedModel.create(("cof_offset",), {"cof_offset": {"offset": offsets[obj]}},
-                                                 PUSHER_OBJECT_FRICTION) for obj in objects})
-    if effect == "pusher_friction":
-        mu = rng.uniform(*PUSHER_FRICTION)
-        return World(effect, seed, {"pusher_friction": mu}, {obj: Effects(pusher_friction=mu) for obj in objects},
-                     testbed, {obj: AugmentedModel.create((), {}, mu) for obj in objects})
-    sigma = rng.uniform(*FRICTION_SIGMA)
-    mean = PUSHER_OBJECT_FRICTION * math.exp(sigma ** 2 / 2)
-    return World(effect, seed, {"pusher_friction_sigma": sigma, "mean_pusher_friction": mean},
-                 {obj: Effects() for obj in objects}, dataclasses.replace(testbed, pusher_friction_sigma=sigma),
-                 {obj: AugmentedModel.create((), {}, mean) for obj in objects})
-
-
 def episode_push_path(data_dir: str | Path, surface: str, obj: str, episode: int, speed_limit: float) -> Path:
     """The push file of episode `episode` (its number in the world's sequence) in the MIT layout, one folder per
     episode so that each is a push sequence of its own (:func:`pushjax.loop.windows.build_examples`):
@@ -339,7 +261,7 @@ def _episode_inputs(config: AdaptConfig, world: World, task: goals.Goal, spec: A
             "controller": repr(config.controller), "max_time": config.max_time, "surface": config.surface}
 
 
-def _outcome(result: closed_loop.EpisodeResult) -> dict:
+def _outcome(result: episode.EpisodeResult) -> dict:
     """What the rows need of an episode (JSON values)."""
     return {"time_s": float(result.time), "position_error_m": float(result.position_error),
             "yaw_error_rad": float(result.yaw_error), "path_length_m": float(result.path_length),
@@ -353,10 +275,125 @@ def _model(summary: dict) -> AugmentedModel:
 def _remove_pushes_from(data_dir: Path, first: int) -> None:
     """Removes the push folders of episodes `first` and later below `data_dir` (a former run's, which the loop of an
     earlier block must not see)."""
-    for episode in sorted(data_dir.glob("*/*/episode=*")):
-        number = episode.name.removeprefix("episode=")
-        if episode.is_dir() and number.isdigit() and int(number) >= first:
-            shutil.rmtree(episode)
+    for folder in sorted(data_dir.glob("*/*/episode=*")):
+        number = folder.name.removeprefix("episode=")
+        if folder.is_dir() and number.isdigit() and int(number) >= first:
+            shutil.rmtree(folder)
+
+
+@dataclasses.dataclass
+class _Tally:
+    """What a run simulated, read back and ran, and its wall time (printed only: the records stay byte-identical)."""
+
+    counts: dict = dataclasses.field(default_factory=lambda: dict.fromkeys(
+        ("simulated", "read back", "loop runs", "loop runs read back"), 0))
+    seconds: dict = dataclasses.field(default_factory=lambda: dict.fromkeys(("episodes", "loop"), 0.0))
+
+    def report(self, workdir: Path) -> None:
+        counts, seconds = self.counts, self.seconds
+        tqdm.tqdm.write(f"adapt: {counts['simulated']} episodes simulated, {counts['read back']} read back; the loop "
+                        f"ran {counts['loop runs']} times, {counts['loop runs read back']} read back ({workdir})")
+        if counts["simulated"] or counts["loop runs"]:
+            tqdm.tqdm.write(f"adapt: {seconds['episodes']:.1f} s simulating and planning "
+                            f"({60 * counts['simulated'] / max(seconds['episodes'], 1e-9):.1f} episodes a minute), "
+                            f"{seconds['loop']:.1f} s in the loop ({seconds['loop'] / max(counts['loop runs'], 1):.1f} "
+                            "s an update), compilation included")
+
+
+@dataclasses.dataclass
+class _WorldRun:
+    """One world of a run (:func:`run`): its goals block by block, every arm on each, the loop after every block;
+    finished episodes and loop runs read back from the records below `folder`."""
+
+    config: AdaptConfig
+    world: World
+    folder: Path
+    tally: _Tally
+    bar: tqdm.tqdm
+    plain: AugmentedModel
+    outcomes: dict[str, dict] = dataclasses.field(default_factory=dict)
+    """Digest of an episode's inputs -> its outcome (simulated or read)."""
+    recordings: dict[str, episode.EpisodeResult] = dataclasses.field(default_factory=dict)
+    """Digest of an episode's inputs -> the episode, simulated in this run."""
+    pushed: list[str] = dataclasses.field(default_factory=list)
+    """The digests of the adaptive arm's episodes so far."""
+    adaptive: AugmentedModel | None = None
+    """The loop's model; None: plain Lynch."""
+
+    @property
+    def data_dir(self) -> Path:
+        return self.folder / "pushes"
+
+    def run(self) -> tuple[list[dict], list[dict]]:
+        """(the episodes' rows, the loop's rows) of the world."""
+        config = self.config
+        tasks = _tasks(config.objects, config.episodes, self.world.seed)
+        episodes, loops = [], []
+        for block in range(config.blocks):
+            for number in range(config.block_start(block), config.block_start(block + 1)):
+                episodes += [self.arm_episode(arm, block, number, tasks[number]) for arm in ARMS]
+            loops.append(self.close_loop(block))
+        return episodes, loops
+
+    def arm_episode(self, arm: str, block: int, number: int, task: goals.Goal) -> dict:
+        """The row of `arm` on goal `number` (`task`), read back or simulated (its record, and the adaptive arm's push
+        file, written)."""
+        config, world, counts = self.config, self.world, self.tally.counts
+        spec = {"adaptive": self.adaptive or self.plain, "plain": self.plain, "oracle": world.oracle[task.obj]}[arm]
+        inputs = _episode_inputs(config, world, task, spec)
+        key = _digest(inputs)
+        path = self.folder / EPISODE_RECORD.format(number, arm)
+        push_path = (episode_push_path(self.data_dir, config.surface, task.obj, number, config.controller.speed_limit)
+                     if arm == "adaptive" else None)
+        self.bar.set_postfix_str(f"{world.effect} world {world.seed} block {block + 1} {arm}")
+        record = _read_record(path, key)
+        if record is not None and (push_path is None or push_path.is_file()):
+            counts["read back"] += 1
+        else:
+            # An arm that plans with the same model on this goal as another pushes as it did.
+            if key not in (self.outcomes if push_path is None else self.recordings):
+                model = make_model(task.obj, mu=spec.mu, effects=spec.effects, params=spec.params)
+                setup = episode.EpisodeConfig(max_time=config.max_time, surface=config.surface,
+                                              testbed=world.testbed, effects=world.effects[task.obj])
+                began = time.perf_counter()
+                self.recordings[key] = episode.run_episode(mpc, model, config.controller, task, seed=world.seed,
+                                                           setup=setup)
+                self.tally.seconds["episodes"] += time.perf_counter() - began
+                self.outcomes[key] = _outcome(self.recordings[key])
+                counts["simulated"] += 1
+            if push_path is not None:
+                recording = self.recordings[key].recording
+                write_push(push_path, None, recording.tip_pose, recording.object_pose, recording.ft_wrench)
+            record = _write_record(path, {"key": key, "inputs": inputs, "outcome": self.outcomes[key]})
+        self.outcomes.setdefault(key, record["outcome"])
+        if arm == "adaptive":
+            self.pushed.append(key)
+        self.bar.update()
+        return _episode_row(world.effect, world.seed, arm, block, number, task, record["outcome"], spec,
+                            config.max_time)
+
+    def close_loop(self, block: int) -> dict:
+        """The loop's row after `block` (run on the adaptive arm's pushes so far, or read back); sets the model the
+        next block plans with."""
+        config, seed = self.config, self.world.seed
+        end = config.block_start(block + 1)
+        self.bar.set_postfix_str(f"{self.world.effect} world {seed}: closing the loop on {end} pushes")
+        inputs = {"loop": dataclasses.asdict(config.loop), "seed": seed, "pushes": self.pushed}
+        key = _digest(inputs)
+        report_dir = self.folder / "loop" / f"block={block}"
+        record = _read_record(report_dir / LOOP_RECORD, key)
+        if record is not None:
+            self.tally.counts["loop runs read back"] += 1
+        else:
+            _remove_pushes_from(self.data_dir, end)
+            began = time.perf_counter()
+            record = _write_record(report_dir / LOOP_RECORD, {
+                "key": key, "inputs": inputs, "row": _loop_row(self.data_dir, report_dir, config.loop, seed)})
+            self.tally.seconds["loop"] += time.perf_counter() - began
+            self.tally.counts["loop runs"] += 1
+        row = record["row"]
+        self.adaptive = _model(row["model"]) if row["ran"] else None
+        return {"effect": self.world.effect, "world": seed, "block": block, "pushes": end, **row}
 
 
 def run(config: AdaptConfig, workdir: str | Path) -> dict:
@@ -381,8 +418,7 @@ def run(config: AdaptConfig, workdir: str | Path) -> dict:
     """
     workdir = Path(workdir)
     episodes, loops, worlds = [], [], []
-    counts = dict.fromkeys(("simulated", "read back", "loop runs", "loop runs read back"), 0)
-    seconds = dict.fromkeys(("episodes", "loop"), 0.0)  # wall time, printed only (records stay byte-identical)
+    tally = _Tally()
     plain = AugmentedModel.create((), {}, PUSHER_OBJECT_FRICTION)
     total = len(config.effects) * config.worlds * config.episodes * len(ARMS)
     with tqdm.tqdm(total=total, desc="adapt: pushing to goals", unit="episode") as bar:
@@ -391,79 +427,11 @@ def run(config: AdaptConfig, workdir: str | Path) -> dict:
                 world = draw_world(effect, seed, config.objects, config.surface, config.testbed)
                 worlds.append({"effect": effect, "seed": seed, "magnitude": world.magnitude,
                                "oracle": {obj: spec.as_dict() for obj, spec in world.oracle.items()}})
-                folder = workdir / effect / f"world={seed}"
-                data_dir = folder / "pushes"
-                tasks = _tasks(config.objects, config.episodes, seed)
-                outcomes: dict[str, dict] = {}  # digest of an episode's inputs -> its outcome (simulated or read)
-                recordings: dict[str, closed_loop.EpisodeResult] = {}  # ... -> the episode, simulated in this run
-                pushed = []  # the digests of the adaptive arm's episodes so far
-                adaptive = None  # the loop's model; None: plain Lynch
-                for block in range(config.blocks):
-                    for number in range(config.block_start(block), config.block_start(block + 1)):
-                        task = tasks[number]
-                        loop = closed_loop.LoopConfig(max_time=config.max_time, surface=config.surface,
-                                                      testbed=world.testbed, effects=world.effects[task.obj])
-                        for arm in ARMS:
-                            spec = {"adaptive": adaptive or plain, "plain": plain,
-                                    "oracle": world.oracle[task.obj]}[arm]
-                            inputs = _episode_inputs(config, world, task, spec)
-                            key = _digest(inputs)
-                            path = folder / EPISODE_RECORD.format(number, arm)
-                            push_path = (episode_push_path(data_dir, config.surface, task.obj, number,
-                                                           config.controller.speed_limit) if arm == "adaptive"
-                                         else None)
-                            bar.set_postfix_str(f"{effect} world {seed} block {block + 1} {arm}")
-                            record = _read_record(path, key)
-                            if record is not None and (push_path is None or push_path.is_file()):
-                                counts["read back"] += 1
-                            else:
-                                # An arm that plans with the same model on this goal as another pushes as it did.
-                                if key not in (outcomes if push_path is None else recordings):
-                                    model = make_model(task.obj, mu=spec.mu, effects=spec.effects, params=spec.params)
-                                    began = time.perf_counter()
-                                    recordings[key] = closed_loop.run_episode(
-                                        model, config.controller, task.obj, task.start, task.goal, seed=seed,
-                                        index=task.index, loop=loop)
-                                    seconds["episodes"] += time.perf_counter() - began
-                                    outcomes[key] = _outcome(recordings[key])
-                                    counts["simulated"] += 1
-                                if push_path is not None:
-                                    recording = recordings[key].recording
-                                    write_push(push_path, None, recording.tip_pose, recording.object_pose,
-                                               recording.ft_wrench)
-                                record = _write_record(path, {"key": key, "inputs": inputs, "outcome": outcomes[key]})
-                            outcomes.setdefault(key, record["outcome"])
-                            if arm == "adaptive":
-                                pushed.append(key)
-                            episodes.append(_episode_row(effect, seed, arm, block, number, task, record["outcome"],
-                                                         spec, config.max_time))
-                            bar.update()
-                    end = config.block_start(block + 1)
-                    bar.set_postfix_str(f"{effect} world {seed}: closing the loop on {end} pushes")
-                    inputs = {"loop": dataclasses.asdict(config.loop), "seed": seed, "pushes": pushed}
-                    key = _digest(inputs)
-                    report_dir = folder / "loop" / f"block={block}"
-                    record = _read_record(report_dir / LOOP_RECORD, key)
-                    if record is not None:
-                        counts["loop runs read back"] += 1
-                    else:
-                        _remove_pushes_from(data_dir, end)
-                        began = time.perf_counter()
-                        record = _write_record(report_dir / LOOP_RECORD, {
-                            "key": key, "inputs": inputs,
-                            "row": _loop_row(data_dir, report_dir, config.loop, seed)})
-                        seconds["loop"] += time.perf_counter() - began
-                        counts["loop runs"] += 1
-                    row = record["row"]
-                    adaptive = _model(row["model"]) if row["ran"] else None
-                    loops.append({"effect": effect, "world": seed, "block": block, "pushes": end, **row})
-    tqdm.tqdm.write(f"adapt: {counts['simulated']} episodes simulated, {counts['read back']} read back; the loop ran "
-                    f"{counts['loop runs']} times, {counts['loop runs read back']} read back ({workdir})")
-    if counts["simulated"] or counts["loop runs"]:
-        tqdm.tqdm.write(f"adapt: {seconds['episodes']:.1f} s simulating and planning "
-                        f"({60 * counts['simulated'] / max(seconds['episodes'], 1e-9):.1f} episodes a minute), "
-                        f"{seconds['loop']:.1f} s in the loop ({seconds['loop'] / max(counts['loop runs'], 1):.1f} s "
-                        "an update), compilation included")
+                world_episodes, world_loops = _WorldRun(config, world, workdir / effect / f"world={seed}", tally, bar,
+                                                        plain).run()
+                episodes += world_episodes
+                loops += world_loops
+    tally.report(workdir)
     results = {"study": "adapt", "settings": config.as_dict(), "comparison_rule": COMPARISON_RULE, "worlds": worlds,
                "episodes": episodes, "loop": loops, "rows": _block_rows(episodes),
                "comparison": {effect: compare([row for row in episodes if row["effect"] == effect],

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 import shapely
 
-from pushjax.control import closed_loop, contact, cost, model
+from pushjax.control import contact, cost, model
 from pushjax.geometry.objects import PUSHER_RADIUS, get_object
+from pushjax.studies import episode
 
 
 @pytest.mark.parametrize("name", ["rect1", "ellip2", "butter"])
@@ -46,7 +47,7 @@ def test_the_detour_does_not_touch_the_object(name, target_index):
     waypoints = contact.detour(push_model.shape, pose, pusher, approach[target_index], world_normals[target_index],
                                push_model.radius, 0.01, 16)
     np.testing.assert_allclose(waypoints[-1], approach[target_index])
-    path = closed_loop.waypoint_targets(np.asarray(pusher), np.asarray(waypoints), 5e-4, 1)
+    path = episode.waypoint_targets(np.asarray(pusher), np.asarray(waypoints), 5e-4, 1)
     path = jnp.asarray(np.concatenate([np.asarray(pusher)[None], path]), jnp.float32)
     steps = model.predict(push_model, pose, path).steps
     assert not bool(steps.touches[1:].any())  # only the first step, leaving the contact, touches

@@ -6,7 +6,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from pushjax.control import cost, model, mpc, push_to_goal
+from pushjax.control import cost, model, mpc
+from pushjax.studies import push_to_goal
 
 CONFIG = push_to_goal.SCALES["smoke"]["controller"]
 
@@ -24,21 +25,21 @@ def test_the_goal_is_reached_with_the_model_as_the_plant():
     goal = jnp.array([0.06, 0.03, 0.5])
     pose, pusher = jnp.zeros(3), jnp.array([-0.1, 0.0])
     state = mpc.init(CONFIG, jax.random.key(0))
-    state, decision = mpc.replan(CONFIG, push_model, state, pose, pusher, goal)
-    assert bool(decision.reposition)  # the pusher starts away from the object
+    state, command = mpc.replan(CONFIG, push_model, state, pose, pusher, goal)
+    assert bool(command.reposition)  # the pusher starts away from the object
     repositions = 0
     for _ in range(60):
-        if decision.reposition:
+        if command.reposition:
             repositions += 1
-            pusher = decision.waypoints[-1]
+            pusher = command.waypoints[-1]
         else:
-            steps = decision.increments[:CONFIG.replan_steps]
+            steps = command.increments[:CONFIG.replan_steps]
             assert float(jnp.linalg.norm(steps, axis=-1).max()) < CONFIG.limit
             path = jnp.concatenate([pusher[None], pusher + jnp.cumsum(steps, axis=0)])
             pose, pusher = model.predict(push_model, pose, path).poses[-1], path[-1]
         position, yaw = cost.pose_error(pose, goal)
         if float(position) < 0.003 and abs(float(yaw)) < np.radians(3):
             break
-        state, decision = mpc.replan(CONFIG, push_model, state, pose, pusher, goal)
+        state, command = mpc.replan(CONFIG, push_model, state, pose, pusher, goal)
     assert float(position) < 0.003 and abs(float(yaw)) < np.radians(3)
     assert repositions >= 1

@@ -8,9 +8,11 @@ import jax
 import numpy as np
 import pytest
 
-from pushjax.filter import metrics, models, noise, tracking
+from pushjax.filter import metrics, models, noise
+from pushjax.filter.observations import TrackedPush
 from pushjax.geometry.objects import PUSHER_RADIUS, get_object
 from pushjax.sim.testbed import REALISTIC
+from pushjax.studies import tracking
 
 RATE_HZ = 5.0
 HAND_SET_MEASUREMENT_STD = np.array([REALISTIC.tracking_noise_xy, REALISTIC.tracking_noise_xy,
@@ -19,7 +21,7 @@ HAND_SET_MEASUREMENT_STD = np.array([REALISTIC.tracking_noise_xy, REALISTIC.trac
 
 
 @functools.cache
-def _pushes(noise_scale: float) -> tuple[tracking.TrackedPush, ...]:
+def _pushes(noise_scale: float) -> tuple[TrackedPush, ...]:
     """Two pushes of rect1 measured with `noise_scale` times the realistic testbed's motion-capture noise."""
     testbed = REALISTIC.with_overrides(f"tracking_noise_xy={noise_scale * REALISTIC.tracking_noise_xy};"
                                        f"tracking_noise_yaw={noise_scale * REALISTIC.tracking_noise_yaw}")
@@ -85,7 +87,7 @@ def test_a_pusher_standing_still_up_to_float_noise_keeps_the_gradient_finite():
     system = models.make_system("rect1", mu=0.25)
     path = _normal_push_ending_still()
     truth = np.asarray(metrics.simulate(system, np.zeros((1, 5)), path[None]), np.float64)[0]
-    pushes = [tracking.TrackedPush(name=f"normal_{k}", obj="rect1", pusher=path,
+    pushes = [TrackedPush(name=f"normal_{k}", obj="rect1", pusher=path,
                                    measurements=metrics.measure(truth, HAND_SET_MEASUREMENT_STD, 0.0, seed=k),
                                    truth=truth, mu_nominal=0.25, mu_true=0.25) for k in range(2)]
     ((system, _, batch),) = tracking.batches_by_object(pushes)

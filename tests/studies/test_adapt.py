@@ -1,8 +1,8 @@
 """``python -m experiments.adapt --scale=smoke`` end to end (the rows of the three arms by block, the figure, the
 controller's own pushes in the MIT layout, the loop run on them after the first block and the second block planned
 with its model), a second run over the same work folder (nothing simulated again, the same bytes; an interrupted
-episode simulated again), a bad flag as one line, and the study's parts without simulation: the config's validation,
-the worlds and their oracles, the comparison rule."""
+episode simulated again), a bad flag as one line, and the study's parts without simulation: the config's validation
+and the comparison rule."""
 
 import json
 import math
@@ -18,7 +18,7 @@ from pushjax import stats
 from pushjax.loop import splits
 from pushjax.mit.files import load_push, parse_push_file_name
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
-from pushjax.studies import adapt
+from pushjax.studies import adapt, worlds
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 
@@ -119,14 +119,14 @@ def test_a_second_run_reads_back_what_the_first_finished(smoke, monkeypatch, cap
     workdir, _ = smoke
     config = adapt.SCALES["smoke"]
     first = _outputs(workdir)
-    run_episode = adapt.closed_loop.run_episode
+    run_episode = adapt.episode.run_episode
     mtimes = {path: path.stat().st_mtime_ns for path in workdir.rglob("*") if path.is_file()}
 
     def refuse(*args, **kwargs):
         raise AssertionError("simulated or ran the loop again")
 
     # Over the finished work folder: nothing simulated and no loop run, the same bytes, no file written again.
-    monkeypatch.setattr(adapt.closed_loop, "run_episode", refuse)
+    monkeypatch.setattr(adapt.episode, "run_episode", refuse)
     monkeypatch.setattr(adapt, "close_loop", refuse)
     adapt.write(adapt.run(config, workdir), workdir)
     assert "adapt: 0 episodes simulated, 54 read back; the loop ran 0 times, 2 read back" in capsys.readouterr().out
@@ -142,11 +142,11 @@ def test_a_second_run_reads_back_what_the_first_finished(smoke, monkeypatch, cap
     (last / "oracle.json").write_text((last / "oracle.json").read_text()[:100])
     calls = []
 
-    def counted(*args, **kwargs):
-        calls.append(kwargs["index"])
-        return run_episode(*args, **kwargs)
+    def counted(controller, model, config, task, **kwargs):
+        calls.append(task.index)
+        return run_episode(controller, model, config, task, **kwargs)
 
-    monkeypatch.setattr(adapt.closed_loop, "run_episode", counted)
+    monkeypatch.setattr(adapt.episode, "run_episode", counted)
     adapt.write(adapt.run(config, workdir), workdir)
     assert len(calls) == 2
     assert "adapt: 2 episodes simulated, 52 read back; the loop ran 0 times, 2 read back" in capsys.readouterr().out
@@ -163,7 +163,7 @@ def test_a_bad_flag_is_one_line(tmp_path):
 def test_the_config_is_validated_and_its_scales_are_defined_once():
     assert set(adapt.SCALES) == {"smoke", "cpu"}
     cpu = adapt.SCALES["cpu"]
-    assert cpu.effects == adapt.EFFECTS and cpu.worlds == 3 and cpu.world_seeds == (0, 1, 2)
+    assert cpu.effects == worlds.EFFECTS and cpu.worlds == 3 and cpu.world_seeds == (0, 1, 2)
     # The loop can run (one push sequence per episode) before the last block.
     assert math.ceil(splits.MIN_SEQUENCES / cpu.per_block) < cpu.blocks
     assert adapt.make_config("smoke", worlds=2, seed=5).world_seeds == (5, 6)
@@ -180,32 +180,6 @@ def test_the_config_is_validated_and_its_scales_are_defined_once():
             adapt.make_config("smoke", **overrides)
     with pytest.raises(ValueError, match="^scale"):
         adapt.make_config("huge")
-
-
-def test_worlds_are_seeded_and_their_oracles_know_the_effect():
-    objects = ("rect1", "tri1")
-    for effect in adapt.EFFECTS:
-        first, again = adapt.draw_world(effect, 3, objects), adapt.draw_world(effect, 3, objects)
-        assert (first.magnitude, first.effects, first.testbed) == (again.magnitude, again.effects, again.testbed)
-        assert {obj: spec.as_dict() for obj, spec in first.oracle.items()} == {
-            obj: spec.as_dict() for obj, spec in again.oracle.items()}
-        assert adapt.draw_world(effect, 3, objects).magnitude != adapt.draw_world(effect, 4, objects).magnitude
-    tilt = adapt.draw_world("tilt", 0, objects)
-    degrees, azimuth = tilt.magnitude["tilt_deg"], math.radians(tilt.magnitude["azimuth_deg"])
-    assert adapt.TILT_DEG[0] <= degrees <= adapt.TILT_DEG[1] and tilt.effects["rect1"].table_tilt_deg == degrees
-    drift = tilt.oracle["rect1"].params["table_tilt"]["drift_force"]
-    np.testing.assert_allclose(drift, math.tan(math.radians(degrees)) / 0.13 * np.array([math.cos(azimuth),
-                                                                                          math.sin(azimuth)]))
-    com = adapt.draw_world("com_offset", 0, objects)
-    for obj in objects:
-        np.testing.assert_allclose(com.oracle[obj].params["cof_offset"]["offset"], com.effects[obj].com_offset)
-    assert np.linalg.norm(com.effects["tri1"].com_offset) < np.linalg.norm(com.effects["rect1"].com_offset)
-    low = adapt.draw_world("pusher_friction", 0, objects)
-    assert low.oracle["rect1"].mu == low.effects["rect1"].pusher_friction < PUSHER_OBJECT_FRICTION
-    spread = adapt.draw_world("friction_variability", 0, objects)
-    sigma = spread.testbed.pusher_friction_sigma
-    assert adapt.FRICTION_SIGMA[0] <= sigma <= adapt.FRICTION_SIGMA[1]
-    assert spread.oracle["rect1"].mu == pytest.approx(PUSHER_OBJECT_FRICTION * math.exp(sigma ** 2 / 2))
 
 
 def _rows(times_by_world):

@@ -18,9 +18,9 @@ measurement noise learned through the differentiable filter (:mod:`pushjax.filte
 hand-set values, on training pushes simulated with another seed than the evaluated ones
 (:data:`TRAINING_SEED_OFFSET`).
 
-A second observation stream (:class:`PositionStream`: the object's centre of mass as a trained perception network
-locates it in the rendered depth image, made by ``pushjax.sensing.perception`` at layer 6, since this module may not
-import a trained model) adds the rows of :data:`PERCEPTION_FILTERS`: ``ekf_perception``, the EKF fusing the motion
+A second observation stream (:class:`~pushjax.filter.observations.PositionStream`: the object's centre of mass as a
+trained perception network locates it in the rendered depth image, made by ``pushjax.sensing.perception`` and passed
+in by ``experiments.track``) adds the rows of :data:`PERCEPTION_FILTERS`: ``ekf_perception``, the EKF fusing the motion
 capture and the readings (:class:`~pushjax.filter.models.PositionSensor`, the readings' own noise), and
 ``ekf_perception_only``, the EKF with the first motion-capture sample as its prior and the readings alone after
 it, beside ``ekf_prediction_only``, the EKF with nothing after the first sample (what the process model alone
@@ -31,7 +31,6 @@ one compiled program: the rows without readings pass an all-missing stream, whic
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from collections.abc import Sequence
@@ -44,17 +43,18 @@ import tqdm
 
 from pushjax import outputs, planar, stats
 from pushjax.filter import constant_velocity, ekf, metrics, models, noise, particle, ukf
+from pushjax.filter.observations import PositionStream, TrackedPush
 from pushjax.geometry.objects import get_object
 from pushjax.sim import dataset
 from pushjax.sim.testbed import Testbed
 
 __all__ = ["FILTERS", "PERCEPTION_FILTERS", "SCALES", "SEED_COMPARISONS", "TRAINING_SEED_OFFSET", "TUNING_SEED",
-           "PositionStream", "TrackedPush", "batches_by_object", "compare_over_seeds", "hand_set_noise", "learn_noise",
-           "run", "simulate_pushes", "seeds_table", "write"]
+           "batches_by_object", "compare_over_seeds", "hand_set_noise", "learn_noise", "run", "simulate_pushes",
+           "seeds_table", "write"]
 
 FILTERS = ("ekf", "ukf", "particle", "ekf_learned")
 PERCEPTION_FILTERS = ("ekf_perception", "ekf_perception_only", "ekf_prediction_only")
-"""The rows a :class:`PositionStream` adds: the EKF with motion capture and the readings, with the readings alone
+"""The rows a :class:`~pushjax.filter.observations.PositionStream` adds: the EKF with motion capture and the readings, with the readings alone
 after the first motion-capture sample, and, their reference, with nothing after it (the process model alone)."""
 RECORDING_RATE_HZ = 250
 SCALES = {
@@ -84,46 +84,6 @@ LATENT_PRIOR_STD = (0.5, 0.3)
 noise (:func:`pushjax.filter.noise.initial_belief`)."""
 ACCELERATION_PSD = (1e-4, 1e-4, 1e-1)
 """Constant-velocity filter: white acceleration spectral densities ((m/s^2)^2 s, (m/s^2)^2 s, (rad/s^2)^2 s)."""
-
-
-@dataclasses.dataclass(frozen=True)
-class TrackedPush:
-    """One simulated push as the filters see it, plus its truth, on the filter clock [T + 1].
-
-    Attributes:
-      name: the file name the push would have.
-      obj: object name.
-      pusher: [T + 1, 2] pusher centre, m.
-      measurements: [T + 1, 3] tracked poses (x m, y m, yaw rad wrapped), NaN rows where dropped.
-      truth: [T + 1, 3] true poses (yaw unwrapped).
-      mu_nominal: the coefficient the file declares.
-      mu_true: the coefficient the push was simulated with.
-    """
-
-    name: str
-    obj: str
-    pusher: np.ndarray
-    measurements: np.ndarray
-    truth: np.ndarray
-    mu_nominal: float
-    mu_true: float
-
-
-@dataclasses.dataclass(frozen=True)
-class PositionStream:
-    """A second sensor's readings of the pushed objects' centres of mass on the filter clock, and its noise.
-
-    Attributes:
-      positions: {push name: [T + 1, 2] readings (world x m, y m) on that push's filter clock, NaN rows where the
-        sensor has none (it runs slower than the filter)}; every evaluated push needs one.
-      std: [2] standard deviation of a reading (world x m, y m), estimated on other pushes than the evaluated ones.
-      details: what ``results.json`` records about the sensor (``perception``): its model, rate and how its noise was
-        estimated.
-    """
-
-    positions: dict[str, np.ndarray]
-    std: tuple[float, float]
-    details: dict
 
 
 def _on_clock(stream: np.ndarray, indices: np.ndarray) -> np.ndarray:
@@ -221,105 +181,72 @@ def learn_noise(pushes: Sequence[TrackedPush], rate_hz: float, measurement_std: 
                        tuple(system for system, _, _ in groups), tuple(batch for _, _, batch in groups), steps)
 
 
-def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, particles: int, seed: int,
-        measurement_std: Sequence[float], training_pushes: Sequence[TrackedPush] = (), learn_steps: int = 0,
-        perception: PositionStream | None = None) -> dict:
-    """Runs the filters and the constant-velocity baseline on the pushes; returns the results (see :func:`write`).
-
-    Args:
-      pushes: the evaluated pushes.
-      filters: names from :data:`FILTERS`.
-      rate_hz: the filter rate, Hz (the pushes' clock).
-      particles: the particle filter's particle count.
-      seed: the particle filter's seed.
-      measurement_std: [3] the hand-set measurement noise (x m, y m, yaw rad).
-      training_pushes: the pushes ``ekf_learned`` learns its noise on (required with it): other pushes than
-        `pushes`, e.g. simulated with another seed (:data:`TRAINING_SEED_OFFSET`).
-      learn_steps: Adam steps of ``ekf_learned``'s noise (:func:`learn_noise`).
-      perception: a second sensor's readings of the evaluated pushes (:class:`PositionStream`): adds the rows of
-        :data:`PERCEPTION_FILTERS` (hand-set noise) and ``perception``.
-    """
-    if perception is not None:
-        missing = sorted({push.name for push in pushes} - set(perception.positions))
-        if missing:
-            raise ValueError(f"perception: no readings of the pushes {missing}")
-        filters = (*filters, *PERCEPTION_FILTERS)
-    dt = 1.0 / rate_hz
-    measurement_std = np.asarray(measurement_std, np.float64)
-    hand_set = hand_set_noise(rate_hz, measurement_std)
-    noises = {name: hand_set for name in filters}
-    learning = None
-    if "ekf_learned" in filters:
-        if not training_pushes:
-            raise ValueError("ekf_learned: expected training pushes to learn the noise on, got none")
+def _track_group(system: models.System, group: Sequence[TrackedPush], batch: noise.PushBatch,
+                 filters: Sequence[str], noises: dict, seed: int, particles: int, measurement_std: np.ndarray,
+                 dt: float, perception: PositionStream | None) -> tuple[dict, dict, np.ndarray]:
+    """({filter: its track of one object's pushes, and the constant-velocity baseline's}, {filter: seconds with
+    compilation}, the [N, T + 1, 2] position readings on the filter clock, NaN where none)."""
+    obj, count = group[0].obj, len(group)
+    paths, measured = batch.pusher, batch.measurements
+    tracks, seconds = {}, {}
+    sensor = models.make_position_sensor(obj, perception.std if perception else (1.0, 1.0))
+    no_readings = np.full(paths.shape, np.nan)
+    readings = (_pad([perception.positions[push.name] for push in group], len(paths[0]), "nan")
+                if perception else no_readings)
+    for name in filters:
         start = time.perf_counter()
-        noises["ekf_learned"], curve = learn_noise(training_pushes, rate_hz, measurement_std, learn_steps)
-        learning = {"steps": learn_steps, "training_pushes": len(training_pushes), "loss_curve": curve.tolist(),
-                    "seconds_with_compile": time.perf_counter() - start}
-    per_push, estimates = [], {name: [] for name in (*filters, "constant_velocity", "raw")}
-    truths, valid_masks = [], []
-    for system, group, batch in tqdm.tqdm(batches_by_object(pushes), unit="object",
-                                          desc="track: filtering each object's pushes"):
-        obj, count = group[0].obj, len(group)
-        paths, measured, truth, valid = batch.pusher, batch.measurements, batch.truth, batch.valid
-        tracks, seconds = {}, {}
-        sensor = models.make_position_sensor(obj, perception.std if perception else (1.0, 1.0))
-        no_readings = np.full(paths.shape, np.nan)
-        readings = (_pad([perception.positions[push.name] for push in group], len(paths[0]), "nan")
-                    if perception else no_readings)
-        for name in filters:
-            start = time.perf_counter()
-            noisy = noise.with_noise(system, noises[name])
-            mean, cov = noise.initial_belief(noises[name], np.asarray(LATENT_PRIOR_STD), measured[:, 0])
-            if name == "particle":
-                keys = jax.random.split(jax.random.key(seed), count)
-                track = particle.filter_pushes(noisy, keys, mean, cov, paths, measured, count=particles)
-            elif name == "ukf":
-                track = ukf.filter_pushes(noisy, mean, cov, paths, measured)
-            else:  # the EKF rows: one program, with the readings or an all-missing stream
-                poses = measured.copy()
-                if name in ("ekf_perception_only", "ekf_prediction_only"):
-                    poses[:, 1:] = np.nan
-                track = ekf.filter_pushes(noisy, mean, cov, paths, poses, sensor,
-                                          readings if name in ("ekf_perception", "ekf_perception_only")
-                                          else no_readings)
-            tracks[name] = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(track))
-            seconds[name] = time.perf_counter() - start
-        cv_mean = np.concatenate([measured[:, 0], np.zeros((count, 3))], axis=-1)
-        cv_cov = np.broadcast_to(np.diag(np.concatenate([measurement_std, [0.05, 0.05, 0.5]]) ** 2), (count, 6, 6))
-        cv = constant_velocity.filter_pushes(measurement_std, ACCELERATION_PSD, dt, cv_mean, cv_cov, measured)
-        tracks["constant_velocity"] = jax.tree_util.tree_map(np.asarray, cv)
-        for k, push in enumerate(group):
-            row = {"name": push.name, "object": obj, "steps": int(valid[k].sum()) - 1,
-                   "dropped": int(np.isnan(push.measurements[:, 0]).sum()), "mu_nominal": push.mu_nominal,
-                   "mu_true": push.mu_true, "filters": {}}
-            poses = {name: tracks[name].mean[k, :, :3] for name in (*filters, "constant_velocity")}
-            poses["raw"] = measured[k]
-            row["errors"] = {}
-            for name, pose in poses.items():
-                position, yaw = metrics.rmse(pose[valid[k]], truth[k][valid[k]])
-                row["errors"][name] = {"position_rmse_mm": 1e3 * position, "yaw_rmse_deg": math.degrees(yaw)}
-            for name in filters:
-                track = tracks[name]
-                mu = push.mu_nominal * np.exp(track.mean[k, :, 3])
-                row["filters"][name] = {
-                    "mu": mu[valid[k]].tolist(), "mu_std_log": np.sqrt(track.cov[k, :, 3, 3])[valid[k]].tolist(),
-                    "l_scale": float(np.exp(track.mean[k, valid[k].sum() - 1, 4])),
-                    "mu_within_20_percent_after_s": _first_time_within(mu, push.mu_true, int(valid[k].sum()), dt)}
-            per_push.append(row)
-        for name in (*filters, "constant_velocity"):
-            estimates[name].append(tracks[name].mean[..., :3])
-        estimates["raw"].append(measured)
-        if perception is not None:
-            true_com = planar.centre_of_mass(get_object(obj).centroid, truth)
-            estimates.setdefault("perception_errors", []).append((readings - true_com)[valid])
-        truths.append(truth)
-        valid_masks.append(valid)
-        for name in filters:
-            estimates.setdefault(f"{name}_cov", []).append(tracks[name].cov)
-            estimates.setdefault(f"{name}_seconds", []).append(seconds[name])
-        estimates.setdefault("constant_velocity_cov", []).append(tracks["constant_velocity"].cov)
+        noisy = noise.with_noise(system, noises[name])
+        mean, cov = noise.initial_belief(noises[name], np.asarray(LATENT_PRIOR_STD), measured[:, 0])
+        if name == "particle":
+            keys = jax.random.split(jax.random.key(seed), count)
+            track = particle.filter_pushes(noisy, keys, mean, cov, paths, measured, count=particles)
+        elif name == "ukf":
+            track = ukf.filter_pushes(noisy, mean, cov, paths, measured)
+        else:  # the EKF rows: one program, with the readings or an all-missing stream
+            poses = measured.copy()
+            if name in ("ekf_perception_only", "ekf_prediction_only"):
+                poses[:, 1:] = np.nan
+            track = ekf.filter_pushes(noisy, mean, cov, paths, poses, sensor,
+                                      readings if name in ("ekf_perception", "ekf_perception_only")
+                                      else no_readings)
+        tracks[name] = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(track))
+        seconds[name] = time.perf_counter() - start
+    cv_mean = np.concatenate([measured[:, 0], np.zeros((count, 3))], axis=-1)
+    cv_cov = np.broadcast_to(np.diag(np.concatenate([measurement_std, [0.05, 0.05, 0.5]]) ** 2), (count, 6, 6))
+    cv = constant_velocity.filter_pushes(measurement_std, ACCELERATION_PSD, dt, cv_mean, cv_cov, measured)
+    tracks["constant_velocity"] = jax.tree_util.tree_map(np.asarray, cv)
+    return tracks, seconds, readings
 
+
+def _push_rows(group: Sequence[TrackedPush], batch: noise.PushBatch, tracks: dict, filters: Sequence[str],
+               dt: float) -> list[dict]:
+    """The rows of ``results["pushes"]`` of one object's pushes: every estimate's errors, every filter's mu."""
+    measured, truth, valid = batch.measurements, batch.truth, batch.valid
+    rows = []
+    for k, push in enumerate(group):
+        row = {"name": push.name, "object": push.obj, "steps": int(valid[k].sum()) - 1,
+               "dropped": int(np.isnan(push.measurements[:, 0]).sum()), "mu_nominal": push.mu_nominal,
+               "mu_true": push.mu_true, "filters": {}}
+        poses = {name: tracks[name].mean[k, :, :3] for name in (*filters, "constant_velocity")}
+        poses["raw"] = measured[k]
+        row["errors"] = {}
+        for name, pose in poses.items():
+            position, yaw = metrics.rmse(pose[valid[k]], truth[k][valid[k]])
+            row["errors"][name] = {"position_rmse_mm": 1e3 * position, "yaw_rmse_deg": math.degrees(yaw)}
+        for name in filters:
+            track = tracks[name]
+            mu = push.mu_nominal * np.exp(track.mean[k, :, 3])
+            row["filters"][name] = {
+                "mu": mu[valid[k]].tolist(), "mu_std_log": np.sqrt(track.cov[k, :, 3, 3])[valid[k]].tolist(),
+                "l_scale": float(np.exp(track.mean[k, valid[k].sum() - 1, 4])),
+                "mu_within_20_percent_after_s": _first_time_within(mu, push.mu_true, int(valid[k].sum()), dt)}
+        rows.append(row)
+    return rows
+
+
+def _summary(filters: Sequence[str], estimates: dict, truths: list, valid_masks: list, per_push: list[dict],
+             perception: PositionStream | None) -> dict:
+    """``results["summary"]``: every estimate's errors and NEES pooled over the pushes, every filter's mu."""
     truth = np.concatenate([t.reshape(-1, 3) for t in truths])
     valid = np.concatenate([v.reshape(-1) for v in valid_masks])
     low, high = metrics.chi2_band(3)
@@ -351,9 +278,68 @@ def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, parti
         errors = errors[np.isfinite(errors[:, 0])]
         summary["perception"] = {"position_rmse_mm": 1e3 * float(np.sqrt(np.mean(np.sum(errors ** 2, axis=-1)))),
                                  "readings": len(errors)}
+    return summary
+
+
+def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, particles: int, seed: int,
+        measurement_std: Sequence[float], training_pushes: Sequence[TrackedPush] = (), learn_steps: int = 0,
+        perception: PositionStream | None = None) -> dict:
+    """Runs the filters and the constant-velocity baseline on the pushes; returns the results (see :func:`write`).
+
+    Args:
+      pushes: the evaluated pushes.
+      filters: names from :data:`FILTERS`.
+      rate_hz: the filter rate, Hz (the pushes' clock).
+      particles: the particle filter's particle count.
+      seed: the particle filter's seed.
+      measurement_std: [3] the hand-set measurement noise (x m, y m, yaw rad).
+      training_pushes: the pushes ``ekf_learned`` learns its noise on (required with it): other pushes than
+        `pushes`, e.g. simulated with another seed (:data:`TRAINING_SEED_OFFSET`).
+      learn_steps: Adam steps of ``ekf_learned``'s noise (:func:`learn_noise`).
+      perception: a second sensor's readings of the evaluated pushes
+        (:class:`~pushjax.filter.observations.PositionStream`): adds the rows of :data:`PERCEPTION_FILTERS` (hand-set
+        noise) and ``perception``.
+    """
+    if perception is not None:
+        missing = sorted({push.name for push in pushes} - set(perception.positions))
+        if missing:
+            raise ValueError(f"perception: no readings of the pushes {missing}")
+        filters = (*filters, *PERCEPTION_FILTERS)
+    dt = 1.0 / rate_hz
+    measurement_std = np.asarray(measurement_std, np.float64)
+    hand_set = hand_set_noise(rate_hz, measurement_std)
+    noises = {name: hand_set for name in filters}
+    learning = None
+    if "ekf_learned" in filters:
+        if not training_pushes:
+            raise ValueError("ekf_learned: expected training pushes to learn the noise on, got none")
+        start = time.perf_counter()
+        noises["ekf_learned"], curve = learn_noise(training_pushes, rate_hz, measurement_std, learn_steps)
+        learning = {"steps": learn_steps, "training_pushes": len(training_pushes), "loss_curve": curve.tolist(),
+                    "seconds_with_compile": time.perf_counter() - start}
+    per_push, estimates = [], {name: [] for name in (*filters, "constant_velocity", "raw")}
+    truths, valid_masks = [], []
+    for system, group, batch in tqdm.tqdm(batches_by_object(pushes), unit="object",
+                                          desc="track: filtering each object's pushes"):
+        tracks, seconds, readings = _track_group(system, group, batch, filters, noises, seed, particles,
+                                                 measurement_std, dt, perception)
+        per_push += _push_rows(group, batch, tracks, filters, dt)
+        for name in (*filters, "constant_velocity"):
+            estimates[name].append(tracks[name].mean[..., :3])
+        estimates["raw"].append(batch.measurements)
+        if perception is not None:
+            true_com = planar.centre_of_mass(get_object(group[0].obj).centroid, batch.truth)
+            estimates.setdefault("perception_errors", []).append((readings - true_com)[batch.valid])
+        truths.append(batch.truth)
+        valid_masks.append(batch.valid)
+        for name in filters:
+            estimates.setdefault(f"{name}_cov", []).append(tracks[name].cov)
+            estimates.setdefault(f"{name}_seconds", []).append(seconds[name])
+        estimates.setdefault("constant_velocity_cov", []).append(tracks["constant_velocity"].cov)
     process_std = _process_std_per_step(rate_hz)
-    results = {"summary": summary, "pushes": per_push, "nees_band_95": [low, high], "rate_hz": rate_hz,
-               "filters": list(filters), "particles": particles, "measurement_std": measurement_std.tolist(),
+    results = {"summary": _summary(filters, estimates, truths, valid_masks, per_push, perception), "pushes": per_push,
+               "nees_band_95": list(metrics.chi2_band(3)), "rate_hz": rate_hz, "filters": list(filters),
+               "particles": particles, "measurement_std": measurement_std.tolist(),
                "process_std_per_step": process_std.tolist(),
                "prior_std": measurement_std.tolist() + list(LATENT_PRIOR_STD),
                "noise": {"hand_set": {"process_std": process_std.tolist(),

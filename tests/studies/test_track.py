@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pushjax.filter import tracking
+from pushjax.studies import tracking
 from pushjax.sim.testbed import REALISTIC
 
 REPOSITORY = Path(__file__).resolve().parents[2]

@@ -10,19 +10,20 @@ import numpy as np
 import pytest
 
 from pushjax import planar
-from pushjax.control import closed_loop, goals, model, push_to_goal
+from pushjax.control import goals, model, mpc
 from pushjax.data import configs as data_configs
 from pushjax.filter import models
 from pushjax.geometry.objects import get_object
 from pushjax.sensing import perception
 from pushjax.sim.testbed import REALISTIC
+from pushjax.studies import episode, push_to_goal
 
 CONFIG = push_to_goal.SCALES["smoke"]["controller"]
 """The smoke run's controller (a short horizon: its programs compile faster, once for both)."""
 
 
 def test_waypoint_targets_keep_the_step_and_the_multiple():
-    targets = closed_loop.waypoint_targets([0.0, 0.0], [[0.01, 0.0], [0.01, 0.003]], 0.001, 25)
+    targets = episode.waypoint_targets([0.0, 0.0], [[0.01, 0.0], [0.01, 0.003]], 0.001, 25)
     assert len(targets) % 25 == 0
     np.testing.assert_allclose(targets[-1], [0.01, 0.003])
     steps = np.linalg.norm(np.diff(np.concatenate([[[0.0, 0.0]], targets]), axis=0), axis=1)
@@ -32,11 +33,11 @@ def test_waypoint_targets_keep_the_step_and_the_multiple():
 
 @pytest.fixture(scope="module")
 def episodes():
-    push_model = model.make_model("rect1")
-    loop = closed_loop.LoopConfig(max_time=20.0)
-    assert loop.testbed == REALISTIC  # the default profile
-    return [closed_loop.run_episode(push_model, CONFIG, "rect1", (0.0, 0.0, 0.0), (0.05, 0.02, 0.3), seed=1,
-                                    loop=loop) for _ in range(2)]
+    planning_model = model.make_model("rect1")
+    setup = episode.EpisodeConfig(max_time=20.0)
+    assert setup.testbed == REALISTIC  # the default profile
+    task = goals.Goal("rect1", 0, (0.0, 0.0, 0.0), (0.05, 0.02, 0.3))
+    return [episode.run_episode(mpc, planning_model, CONFIG, task, seed=1, setup=setup) for _ in range(2)]
 
 
 def test_a_near_goal_is_reached_on_the_realistic_testbed(episodes):
@@ -65,7 +66,7 @@ def test_the_same_seed_gives_the_same_run(episodes):
 
 
 PERCEPTION_MODEL = Path(__file__).resolve().parents[2] / "results" / "track_perception" / "model"
-"""The committed hybrid (``experiments.data_efficiency_full``'s, cpu_full data) that ``tests/filter/test_track.py``
+"""The committed hybrid (``experiments.data_efficiency_full``'s, cpu_full data) that ``tests/studies/test_track.py``
 also reads: a real trained network, read only."""
 
 
@@ -74,13 +75,14 @@ def perceived():
     """A short episode twice with the state from the hybrid's perception of the rendered depth image alone (no motion
     capture), a reading every other control period, the noise of RESULTS.md's perception readings (0.5 mm)."""
     sensor = perception.load(PERCEPTION_MODEL, data_configs.get_config("data_efficiency", "cpu_full"))
-    source = closed_loop.PositionSource(sensor.locate, (5e-4, 5e-4), every=2, description=sensor.description)
-    loop = closed_loop.LoopConfig(max_time=3.0)
-    return [closed_loop.run_episode(model.make_model("rect1"), CONFIG, "rect1", (0.0, 0.0, 0.0), (0.08, 0.0, 0.0),
-                                    seed=2, loop=loop, position=source, motion_capture=False) for _ in range(2)]
+    source = episode.PositionSource(sensor.locate, (5e-4, 5e-4), every=2, description=sensor.description)
+    task = goals.Goal("rect1", 0, (0.0, 0.0, 0.0), (0.08, 0.0, 0.0))
+    return [episode.run_episode(mpc, model.make_model("rect1"), CONFIG, task, seed=2,
+                                setup=episode.EpisodeConfig(max_time=3.0),
+                                sensors=episode.Sensors(motion_capture=False, position=source)) for _ in range(2)]
 
 
-def test_perception_alone_gives_the_loop_its_state_and_the_same_seed_the_same_run(perceived):
+def test_perception_alone_gives_the_episode_its_state_and_the_same_seed_the_same_run(perceived):
     first, second = perceived
     np.testing.assert_array_equal(first.readings, second.readings)
     np.testing.assert_array_equal(first.estimates, second.estimates)
@@ -99,14 +101,13 @@ def test_perception_alone_gives_the_loop_its_state_and_the_same_seed_the_same_ru
     assert np.max(wrong) < 0.003, wrong
 
 
-def test_the_loop_without_motion_capture_needs_a_position_source():
+def test_the_episode_without_motion_capture_needs_a_position_source():
     with pytest.raises(ValueError, match="position source"):
-        closed_loop.run_episode(model.make_model("rect1"), CONFIG, "rect1", (0.0, 0.0, 0.0), (0.05, 0.0, 0.0), seed=0,
-                                motion_capture=False)
+        episode.Sensors(motion_capture=False)
     with pytest.raises(ValueError, match="every"):
-        closed_loop.PositionSource(lambda obj, poses, pushers: poses[:, :2], (5e-4, 5e-4), every=0)
+        episode.PositionSource(lambda obj, poses, pushers: poses[:, :2], (5e-4, 5e-4), every=0)
     with pytest.raises(ValueError, match="std"):
-        closed_loop.PositionSource(lambda obj, poses, pushers: poses[:, :2], (5e-4, 0.0))
+        episode.PositionSource(lambda obj, poses, pushers: poses[:, :2], (5e-4, 0.0))
 
 
 def test_the_gate_skips_a_reading_far_from_the_prediction():
@@ -116,10 +117,10 @@ def test_the_gate_skips_a_reading_far_from_the_prediction():
     centre = jnp.asarray(planar.centre_of_mass(get_object("tri2").centroid, np.asarray(mean[:3])), jnp.float32)
     near, far = centre + jnp.array([1e-3, -1e-3]), centre + jnp.array([0.03, 0.0])  # far: 30 standard deviations off
     for reading, expected in ((near, True), (far, False)):
-        new_mean, new_cov, used = closed_loop.position_update(sensor, mean, cov, reading, 13.8)
+        new_mean, new_cov, used = episode.position_update(sensor, mean, cov, reading, 13.8)
         assert bool(used) == expected
         reference = models.update_position(sensor, mean, cov, reading) if expected else (mean, cov)
         np.testing.assert_allclose(new_mean, reference[0], rtol=1e-5, atol=1e-7)
         np.testing.assert_allclose(new_cov, reference[1], rtol=1e-5, atol=1e-10)
     with pytest.raises(ValueError, match="gate"):
-        closed_loop.PositionSource(lambda obj, poses, pushers: poses[:, :2], (5e-4, 5e-4), gate=0.0)
+        episode.PositionSource(lambda obj, poses, pushers: poses[:, :2], (5e-4, 5e-4), gate=0.0)

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pushjax.control import closed_loop, push_to_goal
+from pushjax.studies import episode, push_to_goal
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 
@@ -35,7 +35,7 @@ def test_smoke_run_writes_results_and_resumes(tmp_path):
     log = (tmp_path / "episodes.jsonl").read_text()
     # The run again with the binary's settings, in this process: every episode is in the log, nothing is simulated.
     again = push_to_goal.run(tmp_path, scale["objects"], scale["goals"], ["lynch"], scale["planners"], 0,
-                             closed_loop.LoopConfig(max_time=scale["max_time"]), "", scale["controller"])
+                             episode.EpisodeConfig(max_time=scale["max_time"]), "", scale["controller"])
     assert (tmp_path / "episodes.jsonl").read_text() == log
     assert again["episodes"] == episodes
 
@@ -59,10 +59,10 @@ def test_model_names_and_effect_parameters():
 
 def test_the_loop_model_needs_its_file(tmp_path):
     with pytest.raises(ValueError, match="loop_model"):
-        push_to_goal.run(tmp_path, ("rect1",), 1, ["lynch", "loop"], ["gradient"], 0, closed_loop.LoopConfig())
+        push_to_goal.run(tmp_path, ("rect1",), 1, ["lynch", "loop"], ["gradient"], 0, episode.EpisodeConfig())
     (tmp_path / "model.json").write_text('{"effects": ["wind"], "params": {}, "pusher_friction": 0.3}')
     with pytest.raises(ValueError, match="model.json: effects: unknown 'wind'"):
-        push_to_goal.run(tmp_path, ("rect1",), 1, ["loop"], ["gradient"], 0, closed_loop.LoopConfig(),
+        push_to_goal.run(tmp_path, ("rect1",), 1, ["loop"], ["gradient"], 0, episode.EpisodeConfig(),
                          loop_model=tmp_path / "model.json")
     assert not (tmp_path / "episodes.jsonl").exists()
 
@@ -74,6 +74,6 @@ def test_state_sources_name_the_rows_and_perception_needs_a_source(tmp_path):
     for states, message in ((["perception"], "position source"), (["mocap", "mocap"], "no repeats"),
                             (["camera"], "expected a non-empty list"), ([], "expected a non-empty list")):
         with pytest.raises(ValueError, match=message):
-            push_to_goal.run(tmp_path, ("rect1",), 1, ["lynch"], ["gradient"], 0, closed_loop.LoopConfig(),
+            push_to_goal.run(tmp_path, ("rect1",), 1, ["lynch"], ["gradient"], 0, episode.EpisodeConfig(),
                              states=states)
     assert not (tmp_path / "episodes.jsonl").exists()
