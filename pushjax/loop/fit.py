@@ -55,8 +55,6 @@ class FitSettings:
       learning_rate: initial step size in units of each parameter's typical magnitude (cosine decay).
       translation_floor_mm: smoothing of the translation error near 0, mm.
       rotation_floor_deg: smoothing of the rotation error near 0, deg.
-      min_padded_size: the fewest windows a batch is padded to (see :func:`padded_size`); fits of subsets of one
-        data set (the groups of the mechanism check) padded to the whole set's size share its compiled programs.
     """
 
     steps: int = 300
@@ -64,7 +62,6 @@ class FitSettings:
     learning_rate: float = 0.05
     translation_floor_mm: float = 0.1
     rotation_floor_deg: float = 0.1
-    min_padded_size: int = 0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -102,10 +99,10 @@ class Batch:
     count: int
 
 
-def to_batch(examples: Examples, min_size: int = 0) -> Batch:
-    """Pads ``examples`` to :func:`padded_size` (at least ``min_size``) by repeating the first window."""
+def to_batch(examples: Examples) -> Batch:
+    """Pads ``examples`` to :func:`padded_size` by repeating the first window."""
     count = len(examples)
-    size = padded_size(max(count, min_size))
+    size = padded_size(count)
     index = np.concatenate([np.arange(count), np.zeros(size - count, int)])
 
     def pad(values):
@@ -117,9 +114,10 @@ def to_batch(examples: Examples, min_size: int = 0) -> Batch:
     return Batch(inputs=inputs, target=pad(examples.target), weight=jnp.asarray(weight), count=count)
 
 
-def zero_scales(examples: Examples) -> tuple[float, float]:
-    """(mean translation m, mean |rotation| rad) of the windows: the zero baseline's mean errors."""
-    target = np.asarray(examples.target)
+def zero_scales(examples: Examples | np.ndarray) -> tuple[float, float]:
+    """(mean translation m, mean |rotation| rad) of the windows (or of their [N, 3] targets): the zero baseline's mean
+    errors."""
+    target = np.asarray(examples.target if isinstance(examples, Examples) else examples)
     return (max(float(np.mean(np.linalg.norm(target[:, :2], axis=1))), 1e-6),
             max(float(np.mean(np.abs(target[:, 2]))), 1e-6))
 
@@ -164,13 +162,14 @@ def _candidate_loss(scaled, mask, batch_inputs, target, weight, scales, floors, 
 
 
 @functools.partial(jax.jit, static_argnames=("learning_rate", "exact"))
-def _optimise(scaled, masks, inputs, target, weight, scales, floors, steps, learning_rate, exact):
-    # The number of steps is traced, not static: cold and warm fits share one compiled program.
+def _optimise(scaled, masks, inputs, target, weights, scales, floors, steps, learning_rate, exact):
+    # The number of steps is traced, not static: cold and warm fits share one compiled program. Every slot has its own
+    # window weights [S, P] and error scales [S, 2] (a slot may fit a subset of the batch's windows).
     optimiser = optax.adam(lambda count: learning_rate * 0.5 * (1 + jnp.cos(jnp.pi * jnp.minimum(count, steps) / steps)))
 
     def total(scaled):
-        losses = jax.vmap(_candidate_loss, in_axes=(0, 0, None, None, None, None, None, None))(
-            scaled, masks, inputs, target, weight, scales, floors, exact)
+        losses = jax.vmap(_candidate_loss, in_axes=(0, 0, None, None, 0, 0, 0, None))(
+            scaled, masks, inputs, target, weights, scales, floors, exact)
         return jnp.sum(losses), losses
 
     def project(scaled):
@@ -260,6 +259,7 @@ def fit_effects(
     examples: Examples,
     settings: FitSettings = FitSettings(),
     initial: Sequence[dict | None] | None = None,
+    subsets: Sequence[np.ndarray | None] | None = None,
 ) -> list[FitResult]:
     """Fits every candidate effect set on ``examples`` at once.
 
@@ -270,6 +270,9 @@ def fit_effects(
       initial: per candidate, None or SI parameters {effect: {parameter: value}} to start from
         (effects not given start at "no effect"); a family whose every candidate starts from given parameters is
         fitted with ``settings.warm_steps``.
+      subsets: per candidate, None (every window) or a [N] boolean mask of the windows it is fitted on, with the error
+        scales of those windows: fits of one model on several groups of a data set (the mechanism check's, the
+        per-group values') run as one compiled call on one batch.
 
     Returns:
       One :class:`FitResult` per candidate, in order.
@@ -278,11 +281,17 @@ def fit_effects(
     if not candidates:
         return []
     initial = list(initial or []) + [None] * (len(candidates) - len(initial or []))
-    batch = to_batch(examples, settings.min_padded_size)
-    scales = jnp.asarray(zero_scales(examples), jnp.float32)
-    floors = jnp.asarray([1e-3 * settings.translation_floor_mm / scales[0],
-                          math.radians(settings.rotation_floor_deg) / scales[1]], jnp.float32)
-    sequence = np.concatenate([examples.sequence, np.full(len(batch.weight) - batch.count, -1)])
+    subsets = list(subsets or []) + [None] * (len(candidates) - len(subsets or []))
+    batch = to_batch(examples)
+    padding = len(batch.weight) - batch.count
+    used = [np.ones(batch.count, bool) if subset is None else np.asarray(subset, bool) for subset in subsets]
+    for k, subset in enumerate(used):
+        if subset.shape != (batch.count,) or not subset.any():
+            raise ValueError(f"subsets[{k}]: expected a [{batch.count}] boolean mask with a window in it")
+    scales = [np.asarray(zero_scales(np.asarray(examples.target)[subset]), np.float32) for subset in used]
+    floors = [np.array([1e-3 * settings.translation_floor_mm / scale[0],
+                        math.radians(settings.rotation_floor_deg) / scale[1]], np.float32) for scale in scales]
+    weights = [np.concatenate([subset, np.zeros(padding, bool)]).astype(np.float32) for subset in used]
     results: list[FitResult | None] = [None] * len(candidates)
     for exact in (False, True):
         members = [k for k, candidate in enumerate(candidates) if is_exact(candidate) == exact]
@@ -299,21 +308,27 @@ def fit_effects(
                 if name in params:
                     params[name] = {key: jnp.asarray(value, jnp.float32) for key, value in values.items()}
             starts.append(_scaled_from_params(params))
+        # Padding slots repeat the first member's windows and scales (their losses are not used).
+        filled = members + [members[0]] * (slots - len(members))
         warm = all(initial[k] for k in members)
-        scaled, losses = _optimise(_stack(starts), jnp.asarray(masks), batch.inputs, batch.target, batch.weight,
-                                   scales, floors, steps=settings.warm_steps if warm else settings.steps,
+        scaled, losses = _optimise(_stack(starts), jnp.asarray(masks), batch.inputs, batch.target,
+                                   jnp.asarray(np.stack([weights[k] for k in filled])),
+                                   jnp.asarray(np.stack([scales[k] for k in filled])),
+                                   jnp.asarray(np.stack([floors[k] for k in filled])),
+                                   steps=settings.warm_steps if warm else settings.steps,
                                    learning_rate=settings.learning_rate, exact=exact)
         scaled, losses = jax.device_get((scaled, losses))
         for slot, k in enumerate(members):
             one = jax.tree.map(lambda leaf: leaf[slot], scaled)
             params = _params_from_scaled(one, masks[slot], exact)
+            sequence = np.where(weights[k] > 0, np.concatenate([examples.sequence, np.full(padding, -1)]), -1)
             results[k] = FitResult(
                 effects=candidates[k],
                 params={name: {key: np.asarray(value) for key, value in params[name].items()}
                         for name in candidates[k]},
                 loss=float(losses[slot]),
-                compute_physical=functools.partial(_physical_with_std, one, masks[slot], batch, scales, floors,
-                                                   sequence, candidates[k], exact),
+                compute_physical=functools.partial(_physical_with_std, one, masks[slot], batch,
+                                                   jnp.asarray(scales[k]), floors[k], sequence, candidates[k], exact),
             )
     return results
 

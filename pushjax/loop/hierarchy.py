@@ -29,19 +29,18 @@ def fit_groups(pool: Examples, effects: tuple[str, ...], variable: str, settings
                initial: dict) -> tuple[list[str], list[fit_lib.FitResult]]:
     """Fits ``effects`` on the pool sequences of each group of ``variable`` with :data:`MIN_GROUP_SEQUENCES`.
 
-    Every group is padded to the pool's size, so that all groups share one compiled program.
+    The groups are fitted in one call on the pool's batch, each on its own windows (``fit_effects``' subsets).
 
     Returns:
       (the groups' labels, their fits); both empty when fewer than two groups have enough sequences.
     """
-    settings = dataclasses.replace(settings, min_padded_size=max(settings.min_padded_size, len(pool)))
     labels = pool.variables[variable]
     groups = [label for label in np.unique(labels)
               if len(np.unique(pool.sequence[labels == label])) >= MIN_GROUP_SEQUENCES]
     if len(groups) < 2:
         return [], []
-    fits = [fit_lib.fit_effects([effects], pool.select(labels == label), settings, initial=[initial])[0]
-            for label in groups]
+    fits = fit_lib.fit_effects([effects] * len(groups), pool, settings, initial=[initial] * len(groups),
+                               subsets=[labels == label for label in groups])
     return [str(label) for label in groups], fits
 
 
