@@ -18,15 +18,15 @@ from pathlib import Path
 
 from absl import app, flags
 
-from pushjax.loop import LoopSettings, select
-from pushjax.loop.fit import FitSettings, fit_effects
+from pushjax.loop import LoopConfig, select
+from pushjax.loop.fit import FitConfig, fit_effects
 from pushjax.loop.pipeline import measured_split
 from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes
 
 _DATA_DIR = flags.DEFINE_string("data_dir", None, "Root of the push files (MIT layout).", required=True)
-_STEPS = flags.DEFINE_integer("steps", FitSettings.steps, "Adam steps of the first fit.", lower_bound=1)
-_WARM_STEPS = flags.DEFINE_integer("warm_steps", FitSettings.warm_steps, "Adam steps of the continuation.",
+_STEPS = flags.DEFINE_integer("steps", FitConfig.steps, "Adam steps of the first fit.", lower_bound=1)
+_WARM_STEPS = flags.DEFINE_integer("warm_steps", FitConfig.warm_steps, "Adam steps of the continuation.",
                                    lower_bound=1)
 _STRIDE = flags.DEFINE_float("stride", None, "Seconds between window starts (default: experiments.close_loop's; "
                              "tests/loop's STRIDE is 0.5).", lower_bound=0.0)
@@ -41,9 +41,9 @@ def main(argv):
     if not pushes.paths:
         raise app.UsageError(f"--data_dir={_DATA_DIR.value}: no push files (motion_surface=...h5) below it")
     examples, _ = build_examples(pushes, stride=_STRIDE.value)
-    split, _, effects = measured_split(examples, LoopSettings(), _SEED.value)
+    split, _, effects = measured_split(examples, LoopConfig(), _SEED.value)
     folds = select._Folds(split)
-    settings = FitSettings(steps=_STEPS.value, warm_steps=_WARM_STEPS.value)
+    settings = FitConfig(steps=_STEPS.value, warm_steps=_WARM_STEPS.value)
     sets = [(name,) for name in effects]
     first = folds.evaluate(sets, [fit_effects(sets, fit, settings) for fit in folds.fit])
     continued = folds.evaluate(sets, [fit_effects(sets, fit, settings, initial=[c.fits[k].params for c in first])

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from absl import app, flags
 
-from pushjax.loop.fit import FitSettings, fit_effects
+from pushjax.loop.fit import FitConfig, fit_effects
 from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes
 
@@ -50,7 +50,7 @@ def main(argv):
     print("| steps | " + " | ".join("+".join(candidate) for candidate in candidates) + f" | {_SHOW.value} parameters |")
     print("|---:|" + "---:|" * len(candidates) + "---|")
     for steps in map(int, _STEPS.value):
-        results = fit_effects(candidates, examples, FitSettings(steps=steps))
+        results = fit_effects(candidates, examples, FitConfig(steps=steps))
         shown = "; ".join(f"{name} {', '.join(f'{x:.4f}' for x in value.ravel())}" for result in results
                           if _SHOW.value in result.effects and (len(result.effects) > 1 or _SHOW_ALONE.value)
                           for name, value in result.params[_SHOW.value].items())

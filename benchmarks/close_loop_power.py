@@ -53,7 +53,7 @@ import jax.numpy as jnp
 from pushjax.geometry import get_object, support
 from pushjax.loop import fit as fit_lib
 from pushjax.loop import metrics
-from pushjax.loop.pipeline import LoopSettings, decide
+from pushjax.loop.pipeline import LoopConfig, decide
 from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes
 from pushjax.physics.effects import support_pressure
@@ -114,7 +114,7 @@ def analyse(data_dir: Path, setup: str, case: str, seed: int, cached_only: bool 
     start = time.perf_counter()
     examples = build_examples(iter_pushes(pushes))[0]
     plain = metrics.window_errors(fit_lib.predict([None], examples)[0], examples.target, examples.sequence)
-    decision = decide(examples, LoopSettings(), seed)
+    decision = decide(examples, LoopConfig(), seed)
     model = decision.selection.model
     outcome = {"selected": decision.selection.selected,
                "alternatives": decision.selection.alternatives,

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pushjax.loop.pipeline import LoopSettings, decide
+from pushjax.loop.pipeline import LoopConfig, decide
 from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes
 
@@ -47,7 +47,7 @@ def main():
         keep = np.isin(examples.sequence, chosen)
     examples = examples.select(np.flatnonzero(keep))
     start = time.perf_counter()
-    decision = decide(examples, LoopSettings(), args.seed)
+    decision = decide(examples, LoopConfig(), args.seed)
     kept = {f"{speed:g} mm/s": int(count) for speed, count in zip(*np.unique(speeds[keep], return_counts=True))}
     print(f"{args.data}: windows {kept}, selected {decision.selection.selected} "
           f"({time.perf_counter() - start:.0f} s)")

@@ -20,22 +20,22 @@ import sys
 from absl import app, flags
 
 import experiments
-from pushjax.loop import LoopSettings, close_loop
-from pushjax.loop.fit import FitSettings
+from pushjax.loop import LoopConfig, close_loop
+from pushjax.loop.fit import FitConfig
 from pushjax.physics.effects import EFFECT_NAMES
 
 _DATA_DIR = flags.DEFINE_string("data_dir", None, "Root of the pushes (raw MIT layout).", required=True)
 _WORKDIR = flags.DEFINE_string("workdir", None, "Output directory.", required=True)
 _HORIZON = flags.DEFINE_float("horizon", 0.5, "Prediction window in s.", lower_bound=0.0)
 _SEED = flags.DEFINE_integer("seed", 0, "Seed of the split, bootstraps and error term.", lower_bound=0)
-_HELDOUT = flags.DEFINE_float("heldout_fraction", LoopSettings.test_fraction,
+_HELDOUT = flags.DEFINE_float("heldout_fraction", LoopConfig.test_fraction,
                               "Share of push sequences in the untouched test split.")
-_MIN_GAIN = flags.DEFINE_float("min_gain", LoopSettings.min_gain,
+_MIN_GAIN = flags.DEFINE_float("min_gain", LoopConfig.min_gain,
                                "Share of the select-split error above the noise floor that an effect must remove, on "
                                "top of being beyond noise.")
-_MIN_STRENGTH = flags.DEFINE_float("min_strength", LoopSettings.min_strength,
+_MIN_STRENGTH = flags.DEFINE_float("min_strength", LoopConfig.min_strength,
                                    "Share of the error a variable's correction must remove to count as structure.")
-_STEPS = flags.DEFINE_integer("steps", FitSettings.steps, "Adam steps per effect fit.", lower_bound=1)
+_STEPS = flags.DEFINE_integer("steps", FitConfig.steps, "Adam steps per effect fit.", lower_bound=1)
 _EFFECTS = flags.DEFINE_list("effects", list(EFFECT_NAMES), "Candidate library effects (default: all).")
 experiments.require_writable_folder("workdir")
 
@@ -45,8 +45,8 @@ def main(argv):
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
     if not 0 < _HORIZON.value < math.inf:
         raise app.UsageError(f"--horizon: expected a positive duration in s, got {_HORIZON.value}")
-    if not 0 < _HELDOUT.value < 1 - LoopSettings.select_fraction:
-        raise app.UsageError(f"--heldout_fraction: expected a fraction in (0, {1 - LoopSettings.select_fraction:g}), "
+    if not 0 < _HELDOUT.value < 1 - LoopConfig.select_fraction:
+        raise app.UsageError(f"--heldout_fraction: expected a fraction in (0, {1 - LoopConfig.select_fraction:g}), "
                              f"got {_HELDOUT.value}")
     if not 0 <= _MIN_GAIN.value < 1:
         raise app.UsageError(f"--min_gain: expected a share of the error above the noise floor in [0, 1), got "
@@ -57,9 +57,9 @@ def main(argv):
     if unknown or not _EFFECTS.value:
         raise app.UsageError(f"--effects: expected library effects from {','.join(EFFECT_NAMES)}, got "
                              f"{','.join(_EFFECTS.value) or 'none'}")
-    settings = LoopSettings(horizon=_HORIZON.value, test_fraction=_HELDOUT.value, min_gain=_MIN_GAIN.value,
+    settings = LoopConfig(horizon=_HORIZON.value, test_fraction=_HELDOUT.value, min_gain=_MIN_GAIN.value,
                             min_strength=_MIN_STRENGTH.value, effects=tuple(_EFFECTS.value),
-                            fit=dataclasses.replace(FitSettings(), steps=_STEPS.value))
+                            fit=dataclasses.replace(FitConfig(), steps=_STEPS.value))
     try:
         result = close_loop(_DATA_DIR.value, _WORKDIR.value, settings, seed=_SEED.value)
     except ValueError as error:

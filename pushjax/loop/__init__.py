@@ -6,6 +6,6 @@ Modules: :mod:`~pushjax.loop.windows` (prediction windows and split), :mod:`~pus
 fallback), :mod:`~pushjax.loop.report` and :mod:`~pushjax.loop.pipeline` (the whole loop).
 """
 
-from pushjax.loop.pipeline import LoopSettings, close_loop
+from pushjax.loop.pipeline import LoopConfig, close_loop
 
-__all__ = ["LoopSettings", "close_loop"]
+__all__ = ["LoopConfig", "close_loop"]

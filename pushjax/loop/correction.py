@@ -47,7 +47,7 @@ class ErrorTerm(nn.Module):
 
 
 @dataclasses.dataclass(frozen=True)
-class CorrectionSettings:
+class CorrectionConfig:
     """Training settings: Adam ``steps`` (full batch) at ``learning_rate`` with ``weight_decay``,
     validation every ``eval_every`` steps, ``hidden`` layer widths."""
 
@@ -111,7 +111,7 @@ def _add(examples: Examples, prediction: np.ndarray, correction: np.ndarray, sca
 def fit_error_correction(
     fit: Examples,
     prediction: np.ndarray,
-    settings: CorrectionSettings = CorrectionSettings(),
+    settings: CorrectionConfig = CorrectionConfig(),
     seed: int = 0,
 ) -> ErrorCorrection:
     """Trains the error term on ``fit`` examples given the model's [N, 3] ``prediction`` on them."""
@@ -151,7 +151,7 @@ def _window_loss(model, params, x, y):
 
 
 @functools.partial(jax.jit, static_argnames="settings")
-def _train(params, x, y, train, validation, settings: CorrectionSettings):
+def _train(params, x, y, train, validation, settings: CorrectionConfig):
     """Adam on the windows weighted by ``train``; the parameters and the loss on the ``validation``
     windows every ``settings.eval_every`` steps, stacked."""
     model = ErrorTerm(settings.hidden)

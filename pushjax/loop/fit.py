@@ -45,7 +45,7 @@ def padded_size(count: int) -> int:
 
 
 @dataclasses.dataclass(frozen=True)
-class FitSettings:
+class FitConfig:
     """Optimiser settings.
 
     Attributes:
@@ -257,7 +257,7 @@ def _stack(trees):
 def fit_effects(
     candidates: Sequence[Sequence[str]],
     examples: Examples,
-    settings: FitSettings = FitSettings(),
+    settings: FitConfig = FitConfig(),
     initial: Sequence[dict | None] | None = None,
     subsets: Sequence[np.ndarray | None] | None = None,
 ) -> list[FitResult]:

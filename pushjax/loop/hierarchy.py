@@ -25,7 +25,7 @@ MIN_GROUP_SEQUENCES = 8
 """Fewest pool sequences of a group for it to be fitted on its own."""
 
 
-def fit_groups(pool: Examples, effects: tuple[str, ...], variable: str, settings: fit_lib.FitSettings,
+def fit_groups(pool: Examples, effects: tuple[str, ...], variable: str, settings: fit_lib.FitConfig,
                initial: dict) -> tuple[list[str], list[fit_lib.FitResult]]:
     """Fits ``effects`` on the pool sequences of each group of ``variable`` with :data:`MIN_GROUP_SEQUENCES`.
 
@@ -81,7 +81,7 @@ class GroupValues:
     groups: dict[str, dict[str, float]]
 
 
-def hierarchical(pool: Examples, model: fit_lib.FitResult, settings: fit_lib.FitSettings,
+def hierarchical(pool: Examples, model: fit_lib.FitResult, settings: fit_lib.FitConfig,
                  variables: Sequence[str] = GROUP_VARIABLES) -> list[GroupValues]:
     """The selected model's values per group of each variable, with shrinkage to a shared value.
 

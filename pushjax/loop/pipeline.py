@@ -33,7 +33,7 @@ from pushjax.physics.effects import EFFECT_NAMES
 
 
 @dataclasses.dataclass(frozen=True)
-class LoopSettings:
+class LoopConfig:
     """Settings of :func:`close_loop`.
 
     Attributes:
@@ -66,8 +66,8 @@ class LoopSettings:
     min_strength: float = diagnose_lib.MIN_STRENGTH
     alpha: float = 0.05
     n_bootstrap: int = 1000
-    fit: fit_lib.FitSettings = fit_lib.FitSettings()
-    correction: correction_lib.CorrectionSettings = correction_lib.CorrectionSettings()
+    fit: fit_lib.FitConfig = fit_lib.FitConfig()
+    correction: correction_lib.CorrectionConfig = correction_lib.CorrectionConfig()
 
 
 @dataclasses.dataclass(frozen=True)
@@ -118,7 +118,7 @@ class Decision:
         return [d for d in self.diagnosis_after if d.beyond_noise]
 
 
-def decide(examples: Examples, settings: LoopSettings = LoopSettings(), seed: int = 0,
+def decide(examples: Examples, settings: LoopConfig = LoopConfig(), seed: int = 0,
            progress: Callable[[str], None] | None = None) -> Decision:
     """Splits the windows, selects effects and tests the fallback and the diagnosis, all without the test split.
 
@@ -174,7 +174,7 @@ def decide(examples: Examples, settings: LoopSettings = LoopSettings(), seed: in
                     alpha=settings.alpha)
 
 
-def measured_split(examples: Examples, settings: LoopSettings = LoopSettings(), seed: int = 0
+def measured_split(examples: Examples, settings: LoopConfig = LoopConfig(), seed: int = 0
                    ) -> tuple[splits_lib.Split, force_lib.ForceFriction, tuple[str, ...]]:
     """The fit/select/test roles of the windows, the pusher friction the force sensor reads on the pool and the
     candidate effects: where the sensor measured it, every window carries the measured coefficient and
@@ -198,7 +198,7 @@ def with_pusher_friction(examples: Examples, mu: float) -> Examples:
 def close_loop(
     data_dir: str | os.PathLike,
     workdir: str | os.PathLike,
-    settings: LoopSettings = LoopSettings(),
+    settings: LoopConfig = LoopConfig(),
     seed: int = 0,
     progress: bool = True,
 ) -> report_lib.LoopResult:
@@ -226,7 +226,6 @@ def close_loop(
     if not pushes.paths:
         raise ValueError(f"data_dir: no push files (motion_surface=...h5) below {str(data_dir)!r}; "
                          f"{pushes.summary()}")
-    workdir = Path(workdir)
     # Closed before an error propagates, so that the error is the last line the user sees.
     with tqdm.tqdm(total=4, desc="close loop", unit="stage", disable=not progress) as stages:
 
@@ -239,102 +238,119 @@ def close_loop(
         try:
             examples, build = build_examples(loading, horizon=settings.horizon, stride=settings.stride,
                                              pusher_friction=settings.pusher_friction)
-        except ValueError as error:  # the files skipped, if any, may be why
-            raise ValueError(f"data_dir: {error}" + (f"; {pushes.summary()}" if pushes.n_skipped else "")) from None
-        n_skipped = pushes.n_skipped + build.n_skipped
-        stages.update()
-
-        try:
+            stages.update()
             decision = decide(examples, settings, seed, stage)
-        except ValueError as error:
+        except ValueError as error:  # the files skipped, if any, may be why
             raise ValueError(f"data_dir: {error}" + (f"; {pushes.summary()}" if pushes.n_skipped else "")) from None
         stages.update()
 
         stage("refitting on the pool and measuring on the test split")
-        split, selection = decision.split, decision.selection
-        pool, test = split.pool, split.test
-        model = selection.model
-        per_group = hierarchy_lib.hierarchical(pool, model, settings.fit) if model is not None else []
-        shape = shape_lib.limit_surface_shape(
-            shape_lib.measured_twists(pool), pool.wrench, pool.inputs.l, pool.sequence,
-            shape_lib.shape_models(pool, model.params if model is not None else None), settings.n_bootstrap, seed)
-        shape = dataclasses.replace(shape, rim_from_force=shape_lib.rim_from_force(pool, shape))
-        term = correction_lib.fit_error_correction(pool, fit_lib.predict([model], pool)[0], settings.correction, seed)
-        plain_test, model_test = fit_lib.predict([None, model], test)
-        fallback_mean, fallback_std = term(test, model_test)
-
-        def measured(prediction) -> report_lib.HeldOutErrors:
-            errors = metrics.window_errors(prediction, test.target, test.sequence)
-            return report_lib.HeldOutErrors.from_summary(
-                metrics.summarize(errors), interval=metrics.bootstrap_interval(errors, settings.n_bootstrap, seed))
-
-        yaw = np.asarray(test.inputs.object_yaw, np.float64)
-        spread = variability_lib.window_spread(model, test, decision.variability)
-        selected_std = np.sqrt(decision.noise ** 2 + spread ** 2)
-        report = report_lib.LoopReport(
-            n_pushes={**split.n_pushes(), "skipped": int(n_skipped)},
-            baseline=measured(plain_test),
-            diagnosis=decision.diagnosis_before,
-            ranking=[report_lib.RankedEffect(effect=c.effects[0], params=c.fits[0].physical[c.effects[0]],
-                                             select=report_lib.Errors.from_summary(c.summary))
-                     for c in selection.ranking],
-            selected=selection.selected,
-            alternatives=selection.alternatives,
-            after=measured(model_test),
-            noise_floor=metrics.noise_floor(test.target, test.sequence, test.push, test.window, test.tracking_noise,
-                                            settings.n_bootstrap, seed, variability=spread),
-            variability=decision.variability,
-            pusher_friction=report_lib.PusherFriction(
-                nominal=settings.pusher_friction, force_sensor=decision.force,
-                from_force_sensor=settings.measure_pusher_friction and decision.force.measured,
-                used=float(pool.inputs.mu[0])),
-            fallback=measured(fallback_mean),
-            remaining=decision.remaining,
-            uncertainty=report_lib.Uncertainty(
-                selected=metrics.predictive_scores(model_test, selected_std, test.target, yaw,
-                                                   decision.selected_multipliers),
-                noise=decision.noise,
-                fallback=metrics.predictive_scores(fallback_mean, fallback_std, test.target, yaw,
-                                                   decision.fallback_multipliers)),
-            per_group=per_group,
-            limit_surface_shape=shape,
-        )
+        report = measure(decision, settings, seed, n_skipped=pushes.n_skipped + build.n_skipped)
         stages.update()
 
         stage("writing the report")
-        details = report_lib.LoopDetails(
-            data_dir=str(data_dir),
-            horizon=settings.horizon,
-            seed=seed,
-            pusher_friction=settings.pusher_friction,
-            alpha=settings.alpha,
-            min_gain=settings.min_gain,
-            cross_fitted=split.cross_fitted,
-            n_sequences={"pool": pool.n_sequences, "test": test.n_sequences},
-            n_windows={"fit": len(split.folds[0][0]), "select": len(split.select_index), "test": len(test)},
-            skipped={**{reason: [p.name for p in paths] for reason, paths in pushes.skipped.items()}, **build.skipped},
-            diagnosis_before=decision.diagnosis_before,
-            diagnosis_after=decision.diagnosis_after,
-            select_noise_floor=selection.noise_floor,
-            rounds=selection.rounds,
-            fallback_gain=decision.fallback_gain,
-            fallback_p_value=decision.fallback_p_value,
-            fallback_beyond_noise=decision.fallback_helps,
-            selected_params=model.physical if model is not None else {},
-        )
+        details = _details(decision, settings, seed, data_dir,
+                           skipped={**{reason: [p.name for p in paths] for reason, paths in pushes.skipped.items()},
+                                    **build.skipped})
+        model = decision.selection.model
         selected_model = model_file.AugmentedModel.create(
             model.effects if model is not None else (), model.params if model is not None else {},
-            float(pool.inputs.mu[0]))
+            float(decision.split.pool.inputs.mu[0]))
         result = report_lib.LoopResult(report=report, details=details, model=selected_model)
-        figures = workdir / report_lib.FIGURE_DIR
-        figures.mkdir(parents=True, exist_ok=True)
-        report_lib.write(workdir, result)
-        selection_windows = pool.select(split.select_index)
-        report_lib.residual_figure(figures / "residual_baseline.png", selection_windows, selection.baseline.prediction,
-                                   "Residual of the plain model (median per bin)", decision.variables)
-        report_lib.residual_figure(figures / "residual_after.png", selection_windows, selection.final.prediction,
-                                   "Residual after the fix: " + (" + ".join(selection.selected) or "nothing selected"),
-                                   decision.variables)
-        report_lib.strength_figure(figures / "diagnosis.png", decision.diagnosis_before, decision.diagnosis_after)
+        _write(Path(workdir), result, decision)
         stages.update()
     return result
+
+
+def measure(decision: Decision, settings: LoopConfig, seed: int, n_skipped: int = 0) -> report_lib.LoopReport:
+    """Refits the decided model's per-group values, the limit surface's shape and the error term on the pool, and
+    measures every model on the untouched test split."""
+    split, selection = decision.split, decision.selection
+    pool, test = split.pool, split.test
+    model = selection.model
+    per_group = hierarchy_lib.hierarchical(pool, model, settings.fit) if model is not None else []
+    shape = shape_lib.limit_surface_shape(
+        shape_lib.measured_twists(pool), pool.wrench, pool.inputs.l, pool.sequence,
+        shape_lib.shape_models(pool, model.params if model is not None else None), settings.n_bootstrap, seed)
+    shape = dataclasses.replace(shape, rim_from_force=shape_lib.rim_from_force(pool, shape))
+    term = correction_lib.fit_error_correction(pool, fit_lib.predict([model], pool)[0], settings.correction, seed)
+    plain_test, model_test = fit_lib.predict([None, model], test)
+    fallback_mean, fallback_std = term(test, model_test)
+
+    def measured(prediction) -> report_lib.HeldOutErrors:
+        errors = metrics.window_errors(prediction, test.target, test.sequence)
+        return report_lib.HeldOutErrors.from_summary(
+            metrics.summarize(errors), interval=metrics.bootstrap_interval(errors, settings.n_bootstrap, seed))
+
+    yaw = np.asarray(test.inputs.object_yaw, np.float64)
+    spread = variability_lib.window_spread(model, test, decision.variability)
+    selected_std = np.sqrt(decision.noise ** 2 + spread ** 2)
+    return report_lib.LoopReport(
+        n_pushes={**split.n_pushes(), "skipped": int(n_skipped)},
+        baseline=measured(plain_test),
+        diagnosis=decision.diagnosis_before,
+        ranking=[report_lib.RankedEffect(effect=c.effects[0], params=c.fits[0].physical[c.effects[0]],
+                                         select=report_lib.Errors.from_summary(c.summary))
+                 for c in selection.ranking],
+        selected=selection.selected,
+        alternatives=selection.alternatives,
+        after=measured(model_test),
+        noise_floor=metrics.noise_floor(test.target, test.sequence, test.push, test.window, test.tracking_noise,
+                                        settings.n_bootstrap, seed, variability=spread),
+        variability=decision.variability,
+        pusher_friction=report_lib.PusherFriction(
+            nominal=settings.pusher_friction, force_sensor=decision.force,
+            from_force_sensor=settings.measure_pusher_friction and decision.force.measured,
+            used=float(pool.inputs.mu[0])),
+        fallback=measured(fallback_mean),
+        remaining=decision.remaining,
+        uncertainty=report_lib.Uncertainty(
+            selected=metrics.predictive_scores(model_test, selected_std, test.target, yaw,
+                                               decision.selected_multipliers),
+            noise=decision.noise,
+            fallback=metrics.predictive_scores(fallback_mean, fallback_std, test.target, yaw,
+                                               decision.fallback_multipliers)),
+        per_group=per_group,
+        limit_surface_shape=shape,
+    )
+
+
+def _details(decision: Decision, settings: LoopConfig, seed: int, data_dir: Path,
+             skipped: dict[str, list[str]]) -> report_lib.LoopDetails:
+    split, selection = decision.split, decision.selection
+    model = selection.model
+    return report_lib.LoopDetails(
+        data_dir=str(data_dir),
+        horizon=settings.horizon,
+        seed=seed,
+        pusher_friction=settings.pusher_friction,
+        alpha=settings.alpha,
+        min_gain=settings.min_gain,
+        cross_fitted=split.cross_fitted,
+        n_sequences={"pool": split.pool.n_sequences, "test": split.test.n_sequences},
+        n_windows={"fit": len(split.folds[0][0]), "select": len(split.select_index), "test": len(split.test)},
+        skipped=skipped,
+        diagnosis_before=decision.diagnosis_before,
+        diagnosis_after=decision.diagnosis_after,
+        select_noise_floor=selection.noise_floor,
+        rounds=selection.rounds,
+        fallback_gain=decision.fallback_gain,
+        fallback_p_value=decision.fallback_p_value,
+        fallback_beyond_noise=decision.fallback_helps,
+        selected_params=model.physical if model is not None else {},
+    )
+
+
+def _write(workdir: Path, result: report_lib.LoopResult, decision: Decision) -> None:
+    """The report's files and its figures."""
+    selection = decision.selection
+    figures = workdir / report_lib.FIGURE_DIR
+    figures.mkdir(parents=True, exist_ok=True)
+    report_lib.write(workdir, result)
+    selection_windows = decision.split.pool.select(decision.split.select_index)
+    report_lib.residual_figure(figures / "residual_baseline.png", selection_windows, selection.baseline.prediction,
+                               "Residual of the plain model (median per bin)", decision.variables)
+    report_lib.residual_figure(figures / "residual_after.png", selection_windows, selection.final.prediction,
+                               "Residual after the fix: " + (" + ".join(selection.selected) or "nothing selected"),
+                               decision.variables)
+    report_lib.strength_figure(figures / "diagnosis.png", decision.diagnosis_before, decision.diagnosis_after)

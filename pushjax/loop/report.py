@@ -454,13 +454,21 @@ def _uncertainty_row(label: str, scores: dict) -> str:
 def markdown(result: LoopResult) -> str:
     """The readable report."""
     report, details = result.report, result.details
+    lines = (_summary_lines(report, details) + _diagnosis_lines(details) + _ranking_lines(report)
+             + _pusher_friction_lines(report) + _variability_lines(report.variability)
+             + _selection_lines(details) + _selected_model_lines(report, details) + _after_lines(report, details))
+    return "\n".join(lines) + "\n"
+
+
+def _summary_lines(report: LoopReport, details: LoopDetails) -> list[str]:
+    """The data, the errors before and after on the test split and how sure the model is."""
     header = ("| model | translation % | rotation % | translation mm | rotation deg | sum % (95 % interval) |\n"
               "|---|---|---|---|---|---|")
     pushes, windows = report.n_pushes, details.n_windows
     roles = ("cross-fitted over sequence folds (every pool push fits and selects, never both for one model)"
              if details.cross_fitted else "one fit split and one select split")
     noise = report.uncertainty.noise
-    lines = [
+    return [
         "# Closing the loop: residual → effect → refit",
         "",
         f"Data: `{details.data_dir}`, horizon {details.horizon} s, seed {details.seed}. "
@@ -494,36 +502,48 @@ def markdown(result: LoopResult) -> str:
         _uncertainty_row("selected model + fitted noise", report.uncertainty.selected),
         _uncertainty_row("learned error term (mean and variance)", report.uncertainty.fallback),
     ]
-    lines += ["", "## Diagnosis of the plain model's residual", "",
-              "Strength: share of the translation + rotation error that a cross-fitted correction by the "
-              "variable's bins removes (see `pushjax.loop.diagnose`); lower: one-sided bootstrap bound.", "",
-              "| variable | strength | lower | axes | beyond noise |", "|---|---|---|---|---|"]
+
+
+def _diagnosis_lines(details: LoopDetails) -> list[str]:
+    lines = ["", "## Diagnosis of the plain model's residual", "",
+             "Strength: share of the translation + rotation error that a cross-fitted correction by the "
+             "variable's bins removes (see `pushjax.loop.diagnose`); lower: one-sided bootstrap bound.", "",
+             "| variable | strength | lower | axes | beyond noise |", "|---|---|---|---|---|"]
     lines += [f"| {d.variable} | {d.strength:.3f} | {d.lower:.3f} | {d.frame} | {d.beyond_noise} |"
               for d in details.diagnosis_before]
-    lines += ["", f"![residual of the plain model]({FIGURE_DIR}/residual_baseline.png)", "",
-              "## Effects ranked by select-split error (each fitted alone)", "",
-              "| effect | parameters (± standard error) | sum % | translation mm | rotation deg |", "|---|---|---|---|---|"]
-    lines += [f"| {entry.effect} | {_params_text(entry.params)} | {entry.select.combined:.1f} | "
-              f"{entry.select.trans_mm:.3f} | {entry.select.rot_deg:.3f} |" for entry in report.ranking]
+    return lines + ["", f"![residual of the plain model]({FIGURE_DIR}/residual_baseline.png)"]
+
+
+def _ranking_lines(report: LoopReport) -> list[str]:
+    lines = ["", "## Effects ranked by select-split error (each fitted alone)", "",
+             "| effect | parameters (± standard error) | sum % | translation mm | rotation deg |", "|---|---|---|---|---|"]
+    return lines + [f"| {entry.effect} | {_params_text(entry.params)} | {entry.select.combined:.1f} | "
+                    f"{entry.select.trans_mm:.3f} | {entry.select.rot_deg:.3f} |" for entry in report.ranking]
+
+
+def _pusher_friction_lines(report: LoopReport) -> list[str]:
     friction, sensor = report.pusher_friction, report.pusher_friction.force_sensor
-    lines += ["", "## Pusher friction from the force sensor", "",
-              (f"While the pusher slid along the object, the force sensor read a pusher–object friction coefficient of "
-               f"{sensor.value:.3f} ± {sensor.std or 0:.3f} ({sensor.n_sequences} pool sequences, "
-               f"{sensor.n_pushes_without} pushes without sliding or force; nominal {friction.nominal:g})"
-               if sensor.value is not None else
-               f"No pool push slid with a force reading ({sensor.n_pushes_without} pushes)") + ". "
-              + (f"Every model uses the measured {friction.used:.3f}, and `pusher_friction` is not a candidate: "
-                 "a measured parameter is no knob." if friction.from_force_sensor else
-                 f"The models use the nominal {friction.used:g}"
-                 + (" (too few sequences slid for a measurement)." if not sensor.measured else "."))]
-    lines += _variability_lines(report.variability)
+    return ["", "## Pusher friction from the force sensor", "",
+            (f"While the pusher slid along the object, the force sensor read a pusher–object friction coefficient of "
+             f"{sensor.value:.3f} ± {sensor.std or 0:.3f} ({sensor.n_sequences} pool sequences, "
+             f"{sensor.n_pushes_without} pushes without sliding or force; nominal {friction.nominal:g})"
+             if sensor.value is not None else
+             f"No pool push slid with a force reading ({sensor.n_pushes_without} pushes)") + ". "
+            + (f"Every model uses the measured {friction.used:.3f}, and `pusher_friction` is not a candidate: "
+               "a measured parameter is no knob." if friction.from_force_sensor else
+               f"The models use the nominal {friction.used:g}"
+               + (" (too few sequences slid for a measurement)." if not sensor.measured else "."))]
+
+
+def _selection_lines(details: LoopDetails) -> list[str]:
+    """Forward selection round by round: the gains, the tests, the fits' convergence and the mechanism checks."""
     select_floor = details.select_noise_floor
-    lines += ["", "## Forward selection", "",
-              f"Every candidate of a round is tested: its gain on the select split must be beyond noise (one-sided "
-              f"sign-flip tests over select push sequences, Holm's procedure over the round's candidates at the "
-              f"family-wise level {details.alpha:g}) and remove more than {details.min_gain:g} of the current "
-              f"error above the select split's noise floor ({select_floor.score:.1f} % from {select_floor.source}); of "
-              f"those that pass, the largest gain is added.", ""]
+    lines = ["", "## Forward selection", "",
+             f"Every candidate of a round is tested: its gain on the select split must be beyond noise (one-sided "
+             f"sign-flip tests over select push sequences, Holm's procedure over the round's candidates at the "
+             f"family-wise level {details.alpha:g}) and remove more than {details.min_gain:g} of the current "
+             f"error above the select split's noise floor ({select_floor.score:.1f} % from {select_floor.source}); of "
+             f"those that pass, the largest gain is added.", ""]
     for k, round_ in enumerate(details.rounds, 1):
         gains = dict(zip(round_.additions, round_.gains))
         best = round_.accepted or max(gains, key=gains.get)
@@ -540,18 +560,26 @@ def markdown(result: LoopResult) -> str:
                          + ("" if round_.converged else
                             f", more than {100 * select_lib.CONVERGENCE_TOLERANCE:g} %: **its fits had not converged**, "
                             "so nothing is added (rerun with more `--steps`)"))
-        for check in round_.mechanism:
-            if check.p_value is None:
-                verdict = "not testable here (one group, or too few sequences per group)"
-            else:
-                worst = check.tests[0]
-                verdict = (f"p = {worst.p_value:.2g} for agreement of {worst.value} across {worst.variable}, "
-                           f"between-group spread {worst.relative_spread:.2f} of the effect's size: "
-                           + ("**a knob, not a mechanism**" if check.is_knob(details.alpha) else "a mechanism"))
-            lines.append(f"   - mechanism check of `{check.effect}`: {verdict}")
+        lines += [f"   - mechanism check of `{check.effect}`: {_mechanism_verdict(check, details.alpha)}"
+                  for check in round_.mechanism]
         if round_.indistinguishable:
             lines.append("   - indistinguishable on the select split: " + ", ".join(
                 f"`{name}` (p = {p:.2g})" for name, p in round_.indistinguishable.items()))
+    return lines
+
+
+def _mechanism_verdict(check: select_lib.MechanismCheck, alpha: float) -> str:
+    if check.p_value is None:
+        return "not testable here (one group, or too few sequences per group)"
+    worst = check.tests[0]
+    return (f"p = {worst.p_value:.2g} for agreement of {worst.value} across {worst.variable}, "
+            f"between-group spread {worst.relative_spread:.2f} of the effect's size: "
+            + ("**a knob, not a mechanism**" if check.is_knob(alpha) else "a mechanism"))
+
+
+def _selected_model_lines(report: LoopReport, details: LoopDetails) -> list[str]:
+    """The selected model's parameters, the limit surface's shape and the values per object and surface."""
+    lines = []
     if report.selected:
         lines += ["", "Fitted parameters of the selected model (every pool push):", ""]
         lines += [f"- {name}: {_params_text(params)}" for name, params in details.selected_params.items()]
@@ -566,8 +594,13 @@ def markdown(result: LoopResult) -> str:
                   + "; ".join(f"{group}: {values['fitted']:.4g} → {values['shrunk']:.4g} ± {values['shrunk_std']:.2g}"
                               for group, values in entry.groups.items()) + " |"
                   for entry in report.per_group]
-    lines += ["", "## Residual after the fix (select split, out of fold)", "",
-              "| variable | strength | lower | beyond noise |", "|---|---|---|---|"]
+    return lines
+
+
+def _after_lines(report: LoopReport, details: LoopDetails) -> list[str]:
+    """The residual after the fix, the learned error term, the noise floor and the verdict."""
+    lines = ["", "## Residual after the fix (select split, out of fold)", "",
+             "| variable | strength | lower | beyond noise |", "|---|---|---|---|"]
     lines += [f"| {d.variable} | {d.strength:.3f} | {d.lower:.3f} | {d.beyond_noise} |"
               for d in details.diagnosis_after]
     lines += ["", f"![residual after the fix]({FIGURE_DIR}/residual_after.png)", "",
@@ -596,4 +629,4 @@ def markdown(result: LoopResult) -> str:
             f"{'lowers' if details.fallback_beyond_noise else 'does not lower'} the error beyond noise, and the "
             f"residual still depends on {remaining}. Test-split sum with the learned term "
             f"{report.fallback.combined:.1f} % instead of {report.after.combined:.1f} %.")
-    return "\n".join(lines) + "\n"
+    return lines

@@ -254,7 +254,7 @@ class _Folds:
 def select_effects(
     split: Split,
     effects: Sequence[str] = EFFECT_NAMES,
-    settings: fit_lib.FitSettings = fit_lib.FitSettings(),
+    settings: fit_lib.FitConfig = fit_lib.FitConfig(),
     min_gain: float = MIN_GAIN,
     alpha: float = 0.05,
     seed: int = 0,
@@ -341,7 +341,7 @@ def select_effects(
                      noise_floor=floor)
 
 
-def check_mechanism(pool: Examples, effects: tuple[str, ...], added: str, settings: fit_lib.FitSettings,
+def check_mechanism(pool: Examples, effects: tuple[str, ...], added: str, settings: fit_lib.FitConfig,
                     initial: dict) -> MechanismCheck:
     """Fits ``effects`` on the pool sequences of each group and tests whether ``added``'s values agree.
 

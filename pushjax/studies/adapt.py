@@ -57,9 +57,9 @@ from pushjax import outputs, stats
 from pushjax.control import goals, gradient, mpc
 from pushjax.control.model import make_model
 from pushjax.geometry.objects import OBJECT_NAMES
-from pushjax.loop import LoopSettings, close_loop
-from pushjax.loop.correction import CorrectionSettings
-from pushjax.loop.fit import FitSettings
+from pushjax.loop import LoopConfig, close_loop
+from pushjax.loop.correction import CorrectionConfig
+from pushjax.loop.fit import FitConfig
 from pushjax.mit.files import PushParams, push_file_name, write_push
 from pushjax.physics.model_file import AugmentedModel
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION, SURFACE_NAMES
@@ -108,7 +108,7 @@ class AdaptConfig:
         plan with what the loop selected.
       max_time: simulated seconds per goal (a failed goal's time to goal).
       controller: the controller's settings (:class:`pushjax.control.mpc.ControllerConfig`).
-      loop: the loop's settings (:class:`pushjax.loop.LoopSettings`).
+      loop: the loop's settings (:class:`pushjax.loop.LoopConfig`).
       surface: the table's surface.
       testbed: the testbed profile the effect is added to.
       seed: the first world seed.
@@ -121,7 +121,7 @@ class AdaptConfig:
     per_block: int
     max_time: float
     controller: mpc.ControllerConfig
-    loop: LoopSettings
+    loop: LoopConfig
     first_block: int | None = None
     surface: str = "abs"
     testbed: Testbed = REALISTIC
@@ -183,13 +183,13 @@ SCALES = {
     # only changes the model's mu). A reduced fit, bootstrap and learned error term.
     "smoke": AdaptConfig(effects=("pusher_friction",), objects=("rect1",), worlds=1, blocks=2, per_block=2,
                          first_block=16, max_time=6.0, controller=_SMOKE_CONTROLLER,
-                         loop=LoopSettings(stride=0.5, n_bootstrap=100, effects=("pusher_friction",),
-                                           fit=FitSettings(steps=20, warm_steps=10),
-                                           correction=CorrectionSettings(steps=100, eval_every=50, hidden=(16,)))),
+                         loop=LoopConfig(stride=0.5, n_bootstrap=100, effects=("pusher_friction",),
+                                           fit=FitConfig(steps=20, warm_steps=10),
+                                           correction=CorrectionConfig(steps=100, eval_every=50, hidden=(16,)))),
     # Every effect in 3 worlds; 4 blocks of 6 goals: the loop first runs after 12 episodes (block 2), so blocks 3 and
     # 4 plan with what it selected. About 3 x 24 episodes of at most 30 s per world, and 4 loop runs.
     "cpu": AdaptConfig(effects=EFFECTS, objects=("rect1",), worlds=3, blocks=4, per_block=6, max_time=30.0,
-                       controller=mpc.ControllerConfig(), loop=LoopSettings()),
+                       controller=mpc.ControllerConfig(), loop=LoopConfig()),
 }
 """The study's scales, defined here and only here."""
 
@@ -439,7 +439,7 @@ def run(config: AdaptConfig, workdir: str | Path) -> dict:
     return outputs.compact(results)
 
 
-def _loop_row(data_dir: Path, report_dir: Path, settings: LoopSettings, seed: int) -> dict:
+def _loop_row(data_dir: Path, report_dir: Path, settings: LoopConfig, seed: int) -> dict:
     """Runs the loop on the pushes in `data_dir` (reports in `report_dir`): ``ran, selected, model, reason``, what the
     next block plans with (``model``: the loop's, :meth:`AugmentedModel.as_dict`; None: plain Lynch) and why."""
     try:

@@ -10,8 +10,8 @@ import pytest
 
 from tests.conftest import _shared_folder, once_across_workers
 
-from pushjax.loop import LoopSettings, close_loop
-from pushjax.loop.fit import FitSettings
+from pushjax.loop import LoopConfig, close_loop
+from pushjax.loop.fit import FitConfig
 from pushjax.sim.dataset import RecordingSettings, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
@@ -61,10 +61,10 @@ CASES = {
 PUSHES = 120
 """Pushes per data set unless the case says otherwise: rect1 on polyurethane at 20 mm/s (quasi-static), drawn
 from the MIT grid."""
-STRIDE = LoopSettings.horizon
+STRIDE = LoopConfig.horizon
 """Windows of the tests' loop runs one after the other instead of overlapping by half (the default): half the windows
 to fit, from the same push sequences (the unit every test and interval of the loop counts)."""
-FIT = FitSettings(steps=150, warm_steps=50)
+FIT = FitConfig(steps=150, warm_steps=50)
 """Half the default Adam steps in the tests' fits (the defaults are the benchmarks'): on these data sets every loop run
 selects the same effects as with the defaults and its test error moves by at most 0.5 points (issue 34), and every
 round from the second on passes the selection's convergence check. The first round is not checked, and on ``pressure``
@@ -95,7 +95,7 @@ def loop_report(record, tmp_path_factory):
 
     def get(name):
         workdir = shared / f"loop_report_{name}"
-        once_across_workers(workdir, lambda: close_loop(record(name), workdir, LoopSettings(stride=STRIDE, fit=FIT),
+        once_across_workers(workdir, lambda: close_loop(record(name), workdir, LoopConfig(stride=STRIDE, fit=FIT),
                                                         progress=False))
         return json.loads((workdir / "report.json").read_text()), workdir
 

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from pushjax.loop import LoopSettings, close_loop
-from pushjax.loop.correction import CorrectionSettings
-from pushjax.loop.fit import FitSettings
+from pushjax.loop import LoopConfig, close_loop
+from pushjax.loop.correction import CorrectionConfig
+from pushjax.loop.fit import FitConfig
 from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes, write_push
 from pushjax.sim import push
@@ -70,9 +70,9 @@ def test_every_episode_is_a_sequence_of_its_own(episodes):
 
 
 def test_the_loop_runs_on_them(episodes, tmp_path):
-    settings = LoopSettings(effects=("table_tilt", "cof_offset"), stride=0.5, n_bootstrap=50,
-                            fit=FitSettings(steps=60, warm_steps=20),
-                            correction=dataclasses.replace(CorrectionSettings(), steps=100, eval_every=50))
+    settings = LoopConfig(effects=("table_tilt", "cof_offset"), stride=0.5, n_bootstrap=50,
+                            fit=FitConfig(steps=60, warm_steps=20),
+                            correction=dataclasses.replace(CorrectionConfig(), steps=100, eval_every=50))
     result = close_loop(episodes, tmp_path, settings, seed=0, progress=False)
     assert sum(result.report.n_pushes[role] for role in ("select", "test")) <= EPISODES
     assert result.report.n_pushes["test"] >= 4

@@ -74,7 +74,7 @@ def test_fits_stopped_far_from_their_optimum_add_nothing(synthetic):
     # selection score by more than the tolerance, so after the last continuation the round refuses instead of
     # crediting the second effect with the first one's unfinished fit.
     split = splits.split(synthetic, len(EFFECT_NAMES), seed=1)
-    selection = select.select_effects(split, settings=fit.FitSettings(steps=10, warm_steps=10))
+    selection = select.select_effects(split, settings=fit.FitConfig(steps=10, warm_steps=10))
     first, second = selection.rounds[:2]
     assert first.converged and first.accepted is not None
     assert second.continuations == select.MAX_CONTINUATIONS
@@ -86,7 +86,7 @@ def test_fits_stopped_far_from_their_optimum_add_nothing(synthetic):
 def test_error_correction_learns_what_the_model_misses(synthetic):
     train, heldout = split_by_sequence(synthetic, 0.3, seed=2)
     plain_train, plain_heldout = fit.predict([None], train)[0], fit.predict([None], heldout)[0]
-    term = correction.fit_error_correction(train, plain_train, correction.CorrectionSettings(steps=600), seed=0)
+    term = correction.fit_error_correction(train, plain_train, correction.CorrectionConfig(steps=600), seed=0)
     before = metrics.combined(metrics.summarize(metrics.window_errors(plain_heldout, heldout.target, heldout.sequence)))
     corrected, std = term(heldout, plain_heldout)
     after = metrics.combined(metrics.summarize(metrics.window_errors(corrected, heldout.target, heldout.sequence)))
@@ -118,7 +118,7 @@ def _two_surfaces(examples, scales):
 
 def test_an_effect_whose_parameters_flip_between_surfaces_is_a_knob(record):
     examples, _ = build_examples(iter_pushes(record("clean")), stride=STRIDE)
-    settings = fit.FitSettings(steps=150)
+    settings = fit.FitConfig(steps=150)
     start = {"pusher_friction": {"log_scale": np.array(0.0)}}
     same = select.check_mechanism(_two_surfaces(examples, {"abs": 0.5, "pu": 0.5}), ("pusher_friction",),
                                   "pusher_friction", settings, start)
