@@ -14,7 +14,6 @@ many it found and how many it needs.
 """
 
 import dataclasses
-import math
 import sys
 
 from absl import app, flags
@@ -38,28 +37,20 @@ _MIN_STRENGTH = flags.DEFINE_float("min_strength", LoopConfig.min_strength,
 _STEPS = flags.DEFINE_integer("steps", FitConfig.steps, "Adam steps per effect fit.", lower_bound=1)
 _EFFECTS = flags.DEFINE_list("effects", list(EFFECT_NAMES), "Candidate library effects (default: all).")
 experiments.require_writable_folder("workdir")
+_FLAG_OF_FIELD = {"test_fraction": "heldout_fraction", "fit": "steps"}
+"""The flag of a ``LoopConfig`` field whose name differs from it."""
 
 
 def main(argv):
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
-    if not 0 < _HORIZON.value < math.inf:
-        raise app.UsageError(f"--horizon: expected a positive duration in s, got {_HORIZON.value}")
-    if not 0 < _HELDOUT.value < 1 - LoopConfig.select_fraction:
-        raise app.UsageError(f"--heldout_fraction: expected a fraction in (0, {1 - LoopConfig.select_fraction:g}), "
-                             f"got {_HELDOUT.value}")
-    if not 0 <= _MIN_GAIN.value < 1:
-        raise app.UsageError(f"--min_gain: expected a share of the error above the noise floor in [0, 1), got "
-                             f"{_MIN_GAIN.value}")
-    if not 0 <= _MIN_STRENGTH.value <= 1:
-        raise app.UsageError(f"--min_strength: expected a share of the error in [0, 1], got {_MIN_STRENGTH.value}")
-    unknown = sorted(set(_EFFECTS.value) - set(EFFECT_NAMES))
-    if unknown or not _EFFECTS.value:
-        raise app.UsageError(f"--effects: expected library effects from {','.join(EFFECT_NAMES)}, got "
-                             f"{','.join(_EFFECTS.value) or 'none'}")
-    settings = LoopConfig(horizon=_HORIZON.value, test_fraction=_HELDOUT.value, min_gain=_MIN_GAIN.value,
-                            min_strength=_MIN_STRENGTH.value, effects=tuple(_EFFECTS.value),
-                            fit=dataclasses.replace(FitConfig(), steps=_STEPS.value))
+    try:
+        settings = LoopConfig(horizon=_HORIZON.value, test_fraction=_HELDOUT.value, min_gain=_MIN_GAIN.value,
+                              min_strength=_MIN_STRENGTH.value, effects=tuple(_EFFECTS.value),
+                              fit=dataclasses.replace(FitConfig(), steps=_STEPS.value))
+    except ValueError as error:
+        field, expected = str(error).split(":", 1)
+        raise app.UsageError(f"--{_FLAG_OF_FIELD.get(field, field)}:{expected}") from None
     try:
         result = close_loop(_DATA_DIR.value, _WORKDIR.value, settings, seed=_SEED.value)
     except ValueError as error:

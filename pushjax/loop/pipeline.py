@@ -8,6 +8,7 @@ the report.
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 from collections.abc import Callable
 from pathlib import Path
@@ -68,6 +69,27 @@ class LoopConfig:
     n_bootstrap: int = 1000
     fit: fit_lib.FitConfig = fit_lib.FitConfig()
     correction: correction_lib.CorrectionConfig = correction_lib.CorrectionConfig()
+
+    def __post_init__(self):
+        """Raises ValueError naming the first field outside its range."""
+        checks = [
+            ("horizon", 0 < self.horizon < math.inf, "a positive duration in s"),
+            ("stride", self.stride is None or 0 < self.stride < math.inf, "a positive duration in s or None"),
+            ("select_fraction", 0 < self.select_fraction < 1, "a fraction in (0, 1)"),
+            ("test_fraction", 0 < self.test_fraction < 1 - self.select_fraction,
+             f"a fraction in (0, {1 - self.select_fraction:g})"),
+            ("pusher_friction", 0 <= self.pusher_friction < math.inf, "a friction coefficient >= 0"),
+            ("effects", bool(self.effects) and set(self.effects) <= set(EFFECT_NAMES),
+             f"library effects from {','.join(EFFECT_NAMES)}"),
+            ("min_gain", 0 <= self.min_gain < 1, "a share of the error above the noise floor in [0, 1)"),
+            ("min_strength", 0 <= self.min_strength <= 1, "a share of the error in [0, 1]"),
+            ("alpha", 0 < self.alpha < 1, "a level in (0, 1)"),
+            ("n_bootstrap", self.n_bootstrap >= 1, "at least 1 resampling"),
+            ("fit", self.fit.steps >= 1 and self.fit.warm_steps >= 1, "at least 1 Adam step (steps, warm_steps)"),
+        ]
+        for field, valid, expected in checks:
+            if not valid:
+                raise ValueError(f"{field}: expected {expected}, got {getattr(self, field)!r}")
 
 
 @dataclasses.dataclass(frozen=True)
