@@ -567,8 +567,13 @@ def _negated(values: Mapping) -> dict:
 def markdown(results: Mapping) -> str:
     """The decomposition as markdown: the rows, the parts and what they bound."""
     rows = {row["component"]: row for row in results["rows"]}
-    parts, checks, zero = results["parts"], results["checks"], results["zero"]
-    floor, truth, physics, state = rows["drawn_load"], rows["truth"], rows["physics"], rows["state_floor"]
+    lines = _table_lines(results, rows) + _bound_lines(results["parts"], rows) + _check_lines(results)
+    return "\n".join(lines) + "\n"
+
+
+def _table_lines(results: Mapping, rows: Mapping) -> list[str]:
+    """The title, what the numbers are and the table of the rows."""
+    zero = results["zero"]
     lines = [
         "# The physics baseline's error decomposed",
         "",
@@ -590,7 +595,13 @@ def markdown(results: Mapping) -> str:
                      f"{_change(change, 'trans_percent') if change else ''} | "
                      f"{_change(change, 'rot_percent') if change else ''} | "
                      f"{row['trans_mm']:.3f} / {row['rot_deg']:.3f} |")
-    lines += [
+    return lines
+
+
+def _bound_lines(parts: Mapping, rows: Mapping) -> list[str]:
+    """The section "What it bounds": the parts of the error and what a model could gain."""
+    floor, truth, physics, state = rows["drawn_load"], rows["truth"], rows["physics"], rows["state_floor"]
+    return [
         "",
         "## What it bounds",
         "",
@@ -631,6 +642,13 @@ def markdown(results: Mapping) -> str:
         "takes the prediction at the nominal draws for the best guess without them (a model that learnt the "
         "conditional median over the draws could do slightly better); errors are norms, so the rows' steps depend "
         "on their order and do not add exactly.",
+    ]
+
+
+def _check_lines(results: Mapping) -> list[str]:
+    """The section "Checks": the resimulation, the labels cut again, the contact flags, the solves' convergence."""
+    checks = results["checks"]
+    return [
         "",
         "## Checks",
         "",
@@ -645,7 +663,6 @@ def markdown(results: Mapping) -> str:
         f"{checks['exact_not_converged']} (largest residual {checks['exact_largest_residual']:.1e}).",
         f"* Wall time {results['wall_s']:.0f} s, of which {results['simulation_s']:.0f} s simulating.",
     ]
-    return "\n".join(lines) + "\n"
 
 
 def write(results: Mapping, out_dir: str | Path) -> list[Path]:

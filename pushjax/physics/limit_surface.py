@@ -289,27 +289,42 @@ def dissipation(twist, support_points, support_weights, patch_radius):
     return _sum(p * norm), wrench
 
 
-@functools.partial(jax.jit, static_argnames=("stick_iterations", "slip_iterations"))
-def solve(contact, normal, action, mu, support_points, support_weights, patch_radius, s=1.0, drift_force=None,
-          *, stick_iterations: int = ITERATIONS["stick"], slip_iterations: int = ITERATIONS["slip"]) -> Solution:
-    """Twist, pusher force and contact mode of a push on the exact limit surface.
+class _Pushes(NamedTuple):
+    """The pushes of :func:`solve`, broadcast to the batch shape [...] and one dtype.
 
-    Args:
-      contact: [..., 2] contact point, relative to the origin of ``support_points`` [length].
-      normal: [..., 2] surface normal at the contact, into the object; any length, zero = no contact.
-      action: [..., 2] pusher motion u [length (per step)].
-      mu: [...] pusher-object friction coefficient, >= 0.
-      support_points: [..., K, 2] support points r_k (same frame and origin as ``contact``) [length].
-      support_weights: [..., K] pressure weights p_k >= 0, normalised inside; zeros are padding.
-      patch_radius: [...] radius rho > 0 of each support's disc patch [length].
-      s: [...] contact indicator in [0, 1], scales the twist.
-      drift_force: [..., 2] constant in-plane force at the origin in units of the total support friction
-        force (strictly inside the limit surface); None for none.
-      stick_iterations, slip_iterations: Newton iterations (static).
-
-    Returns:
-      :class:`Solution` (twist [..., 3], force [..., 2], sticking [...], slipping [...], residual [...]).
+    The normal ``(nx, ny)`` is the unit normal (``(1, 0)`` without contact), ``(unit_ux, unit_uy)`` the action's
+    direction (the normal without motion); ``normal_push = u . n``; ``pushing`` whether the pusher pushes;
+    ``(dx, dy)`` [..., K] the supports relative to the contact, ``p`` [..., K] their normalised weights, ``beta_t``
+    the drift force's linear coefficient of the rotation rate, ``g . (c_y, -c_x)``.
     """
+
+    cx: jax.Array
+    cy: jax.Array
+    nx: jax.Array
+    ny: jax.Array
+    ux: jax.Array
+    uy: jax.Array
+    unit_ux: jax.Array
+    unit_uy: jax.Array
+    action_length: jax.Array
+    normal_push: jax.Array
+    pushing: jax.Array
+    gx: jax.Array
+    gy: jax.Array
+    mu: jax.Array
+    rho: jax.Array
+    s: jax.Array
+    rx: jax.Array
+    ry: jax.Array
+    p: jax.Array
+    dx: jax.Array
+    dy: jax.Array
+    beta_t: jax.Array
+
+
+def _pushes(contact, normal, action, mu, support_points, support_weights, patch_radius, s,
+            drift_force) -> tuple[_Pushes, jnp.dtype]:
+    """The inputs of :func:`solve` checked, broadcast and made unit where the solve needs it; and their dtype."""
     contact, normal, action, mu, points, weights, rho, s = map(
         jnp.asarray, (contact, normal, action, mu, support_points, support_weights, patch_radius, s))
     drift = jnp.zeros(2) if drift_force is None else jnp.asarray(drift_force)
@@ -346,52 +361,92 @@ def solve(contact, normal, action, mu, support_points, support_weights, patch_ra
     unit_uy = jnp.where(moving, uy / jnp.where(moving, action_length, 1), ny)
     normal_push = ux * nx + uy * ny  # u . n with the unit normal
     pushing = has_normal & moving & (normal_push > 0)
-
-    # Ellipsoid about the weighted centroid for the initial guesses: l^2 = E|r - centroid|^2 / 2 + rho^2,
-    # the effective l of small rotations.
-    centroid_x, centroid_y = _sum(p * rx), _sum(p * ry)
-    l2 = 0.5 * _sum(p * ((rx - centroid_x[..., None]) ** 2 + (ry - centroid_y[..., None]) ** 2)) + rho * rho
-    # Positive also for the invalid rho = 0 with a single support (keeps the guesses finite there).
-    l2 = jax.lax.stop_gradient(jnp.maximum(l2, jnp.finfo(dtype).eps * (cx * cx + cy * cy + 1e-6)))
-    ccx, ccy = cx - centroid_x, cy - centroid_y  # contact relative to the centroid
-
     dx, dy = rx - cx[..., None], ry - cy[..., None]
-    zero = jnp.zeros_like(cx)
     # G . V(t) = g . (a - t k x c): linear coefficient of t is g . (c_y, -c_x); of sigma, g . e.
     beta_t = gx * cy - gy * cx
+    return _Pushes(cx, cy, nx, ny, ux, uy, unit_ux, unit_uy, action_length, normal_push, pushing, gx, gy, mu, rho, s,
+                   rx, ry, p, dx, dy, beta_t), dtype
 
-    # Sticking: a = u / |u|, 1-D in t. Guess: the minimiser on the ellipsoid, where the dissipation along
-    # the line is one hyperbola sqrt(alpha t^2 + 2 beta t + 1) (centroid velocity u - t k x c') plus the
-    # drift term -g . v = -beta_t t: t = t_c + h tau / sqrt(1 - tau^2), tau = beta_t / sqrt(alpha),
-    # t_c = -beta / alpha, h^2 = (1 - beta^2 / alpha) / alpha.
-    stick_problem = _Problem(unit_ux, unit_uy, zero, zero, zero, beta_t, dx, dy, p, rho)
-    alpha = l2 + ccx * ccx + ccy * ccy
-    beta = ccy * unit_ux - ccx * unit_uy  # -(c' x u)
-    tau = jnp.clip(beta_t / jnp.sqrt(alpha), -0.95, 0.95)
+
+class _Ellipsoid(NamedTuple):
+    """The ellipsoid about the supports' weighted centroid that gives the solves' initial guesses: the centroid, its
+    ``l^2 = E|r - centroid|^2 / 2 + rho^2`` (the effective l of small rotations) and the contact relative to it."""
+
+    centroid_x: jax.Array
+    centroid_y: jax.Array
+    l2: jax.Array
+    ccx: jax.Array
+    ccy: jax.Array
+
+
+def _ellipsoid(q: _Pushes, dtype) -> _Ellipsoid:
+    centroid_x, centroid_y = _sum(q.p * q.rx), _sum(q.p * q.ry)
+    l2 = 0.5 * _sum(q.p * ((q.rx - centroid_x[..., None]) ** 2 + (q.ry - centroid_y[..., None]) ** 2)) + q.rho * q.rho
+    # Positive also for the invalid rho = 0 with a single support (keeps the guesses finite there).
+    l2 = jax.lax.stop_gradient(jnp.maximum(l2, jnp.finfo(dtype).eps * (q.cx * q.cx + q.cy * q.cy + 1e-6)))
+    return _Ellipsoid(centroid_x, centroid_y, l2, q.cx - centroid_x, q.cy - centroid_y)
+
+
+def _stick(q: _Pushes, guess: _Ellipsoid, iterations: int):
+    """The sticking solve, 1-D in the rotation rate t with the contact moving as the pusher (a = u / |u|).
+
+    Returns (t, pusher force x, y, the objective's derivative in t (its residual), whether the contact sticks).
+    """
+    zero = jnp.zeros_like(q.cx)
+    # Guess: the minimiser on the ellipsoid, where the dissipation along the line is one hyperbola
+    # sqrt(alpha t^2 + 2 beta t + 1) (centroid velocity u - t k x c') plus the drift term -g . v = -beta_t t:
+    # t = t_c + h tau / sqrt(1 - tau^2), tau = beta_t / sqrt(alpha), t_c = -beta / alpha,
+    # h^2 = (1 - beta^2 / alpha) / alpha.
+    problem = _Problem(q.unit_ux, q.unit_uy, zero, zero, zero, q.beta_t, q.dx, q.dy, q.p, q.rho)
+    ccx, ccy = guess.ccx, guess.ccy
+    alpha = guess.l2 + ccx * ccx + ccy * ccy
+    beta = ccy * q.unit_ux - ccx * q.unit_uy  # -(c' x u)
+    tau = jnp.clip(q.beta_t / jnp.sqrt(alpha), -0.95, 0.95)
     t0 = -beta / alpha + jnp.sqrt(jnp.maximum(1 - beta * beta / alpha, 0) / alpha) * tau / jnp.sqrt(1 - tau * tau)
     t0 = jax.lax.stop_gradient(t0)
-    _, t_stick = _solve_x(False, stick_iterations, stick_problem, zero, t0)
-    z1, z2, z3, inverse = _patch_velocities(stick_problem, zero, t_stick)
-    force_x = _sum(p * z1 * inverse) - gx
-    force_y = _sum(p * z2 * inverse) - gy
-    rho_k = rho[..., None]
-    stick_torque = _sum(p * (-z1 * dy + z2 * dx + z3 * rho_k) * inverse) - beta_t  # d objective / dt
-    inside = jnp.abs(nx * force_y - ny * force_x) <= mu * (nx * force_x + ny * force_y)
-    sticking = pushing & inside
+    _, t_stick = _solve_x(False, iterations, problem, zero, t0)
+    z1, z2, z3, inverse = _patch_velocities(problem, zero, t_stick)
+    force_x = _sum(q.p * z1 * inverse) - q.gx
+    force_y = _sum(q.p * z2 * inverse) - q.gy
+    torque = _sum(q.p * (-z1 * q.dy + z2 * q.dx + z3 * q.rho[..., None]) * inverse) - q.beta_t  # d objective / dt
+    inside = jnp.abs(q.nx * force_y - q.ny * force_x) <= q.mu * (q.nx * force_x + q.ny * force_y)
+    return t_stick, force_x, force_y, torque, q.pushing & inside
 
-    # Slipping: f_b on the side where the sticking force leaves the cone; f_b . J V = 1, 2-D in (sigma, t).
-    side_mu = jnp.where(nx * force_y - ny * force_x > 0, mu, -mu)
+
+class _Slip(NamedTuple):
+    """The slipping solve's result: the tangent ``(ex, ey)``, the contact velocity ``(ax, ay)`` and rotation rate
+    ``t`` with ``f_b . J V = 1``, the contact's normal velocity, whether it slips, the pusher force and the
+    objective's derivative in t."""
+
+    ex: jax.Array
+    ey: jax.Array
+    ax: jax.Array
+    ay: jax.Array
+    t: jax.Array
+    normal_velocity: jax.Array
+    slipping: jax.Array
+    force_x: jax.Array
+    force_y: jax.Array
+    torque: jax.Array
+
+
+def _slip(q: _Pushes, guess: _Ellipsoid, stick_force_x, stick_force_y, sticking, iterations: int, dtype) -> _Slip:
+    """The slipping solve: f_b on the side where the sticking force leaves the cone; f_b . J V = 1, 2-D in
+    (sigma, t)."""
+    nx, ny, gx, gy = q.nx, q.ny, q.gx, q.gy
+    side_mu = jnp.where(nx * stick_force_y - ny * stick_force_x > 0, q.mu, -q.mu)
     bx, by = nx - side_mu * ny, ny + side_mu * nx
     b2 = bx * bx + by * by  # >= 1
     b_length = jnp.sqrt(b2)
     a0x, a0y = bx / b2, by / b2
     ex, ey = -by / b_length, bx / b_length
-    slip_problem = _Problem(a0x, a0y, ex, ey, gx * ex + gy * ey, beta_t, dx, dy, p, rho)
+    problem = _Problem(a0x, a0y, ex, ey, gx * ex + gy * ey, q.beta_t, q.dx, q.dy, q.p, q.rho)
     # Guess: the ellipsoid's slipping twist. About the centroid the wrench (lambda f_b + g, lambda m_b + m_g)
     # (m_b = c' x f_b, m_g = -centroid x g) lies on |f|^2 + m^2 / l^2 = 1, and the twist is (f, m / l^2);
     # scaled to f_b . J V = 1.
+    ccx, ccy, l2 = guess.ccx, guess.ccy, guess.l2
     m_b = ccx * by - ccy * bx
-    m_g = centroid_y * gx - centroid_x * gy
+    m_g = guess.centroid_y * gx - guess.centroid_x * gy
     quadratic = b2 + m_b * m_b / l2
     linear = bx * gx + by * gy + m_b * m_g / l2
     constant = gx * gx + gy * gy + m_g * m_g / l2 - 1
@@ -401,30 +456,60 @@ def solve(contact, normal, action, mu, support_points, support_weights, patch_ra
     kappa = 1 / jnp.maximum(velocity_x * bx + velocity_y * by, jnp.finfo(dtype).tiny * 1e8)
     sigma0 = jax.lax.stop_gradient(kappa * (velocity_x * ex + velocity_y * ey))
     slip_t0 = jax.lax.stop_gradient(kappa * omega)
-    sigma, t_slip = _solve_x(True, slip_iterations, slip_problem, sigma0, slip_t0)
+    sigma, t_slip = _solve_x(True, iterations, problem, sigma0, slip_t0)
     slip_ax, slip_ay = a0x + sigma * ex, a0y + sigma * ey
     normal_velocity = slip_ax * nx + slip_ay * ny
-    slipping = pushing & ~sticking & (normal_velocity > 0)
-    z1s, z2s, z3s, inverse_s = _patch_velocities(slip_problem, sigma, t_slip)
-    slip_force_x = _sum(p * z1s * inverse_s) - gx
-    slip_force_y = _sum(p * z2s * inverse_s) - gy
-    slip_torque = _sum(p * (-z1s * dy + z2s * dx + z3s * rho_k) * inverse_s) - beta_t
+    slipping = q.pushing & ~sticking & (normal_velocity > 0)
+    z1s, z2s, z3s, inverse_s = _patch_velocities(problem, sigma, t_slip)
+    slip_force_x = _sum(q.p * z1s * inverse_s) - gx
+    slip_force_y = _sum(q.p * z2s * inverse_s) - gy
+    slip_torque = _sum(q.p * (-z1s * q.dy + z2s * q.dx + z3s * q.rho[..., None]) * inverse_s) - q.beta_t
+    return _Slip(ex, ey, slip_ax, slip_ay, t_slip, normal_velocity, slipping, slip_force_x, slip_force_y, slip_torque)
+
+
+@functools.partial(jax.jit, static_argnames=("stick_iterations", "slip_iterations"))
+def solve(contact, normal, action, mu, support_points, support_weights, patch_radius, s=1.0, drift_force=None,
+          *, stick_iterations: int = ITERATIONS["stick"], slip_iterations: int = ITERATIONS["slip"]) -> Solution:
+    """Twist, pusher force and contact mode of a push on the exact limit surface.
+
+    Args:
+      contact: [..., 2] contact point, relative to the origin of ``support_points`` [length].
+      normal: [..., 2] surface normal at the contact, into the object; any length, zero = no contact.
+      action: [..., 2] pusher motion u [length (per step)].
+      mu: [...] pusher-object friction coefficient, >= 0.
+      support_points: [..., K, 2] support points r_k (same frame and origin as ``contact``) [length].
+      support_weights: [..., K] pressure weights p_k >= 0, normalised inside; zeros are padding.
+      patch_radius: [...] radius rho > 0 of each support's disc patch [length].
+      s: [...] contact indicator in [0, 1], scales the twist.
+      drift_force: [..., 2] constant in-plane force at the origin in units of the total support friction
+        force (strictly inside the limit surface); None for none.
+      stick_iterations, slip_iterations: Newton iterations (static).
+
+    Returns:
+      :class:`Solution` (twist [..., 3], force [..., 2], sticking [...], slipping [...], residual [...]).
+    """
+    q, dtype = _pushes(contact, normal, action, mu, support_points, support_weights, patch_radius, s, drift_force)
+    guess = _ellipsoid(q, dtype)
+    t_stick, force_x, force_y, stick_torque, sticking = _stick(q, guess, stick_iterations)
+    slip = _slip(q, guess, force_x, force_y, sticking, slip_iterations, dtype)
+    slipping = slip.slipping
 
     # Twist: contact velocity a and rotation t give v = a - t k x c = a + t (c_y, -c_x).
-    ratio = jnp.where(slipping, normal_push / jnp.where(slipping, normal_velocity, 1), 0)
-    stick_scale = jnp.where(sticking, action_length, 0)
+    ratio = jnp.where(slipping, q.normal_push / jnp.where(slipping, slip.normal_velocity, 1), 0)
+    stick_scale = jnp.where(sticking, q.action_length, 0)
     twist = jnp.stack([
-        stick_scale * (unit_ux + t_stick * cy) + ratio * (slip_ax + t_slip * cy),
-        stick_scale * (unit_uy - t_stick * cx) + ratio * (slip_ay - t_slip * cx),
-        stick_scale * t_stick + ratio * t_slip,
-    ], axis=-1) * s[..., None]
+        stick_scale * (q.unit_ux + t_stick * q.cy) + ratio * (slip.ax + slip.t * q.cy),
+        stick_scale * (q.unit_uy - t_stick * q.cx) + ratio * (slip.ay - slip.t * q.cx),
+        stick_scale * t_stick + ratio * slip.t,
+    ], axis=-1) * q.s[..., None]
     force = jnp.stack([
-        jnp.where(sticking, force_x, jnp.where(slipping, slip_force_x, 0)),
-        jnp.where(sticking, force_y, jnp.where(slipping, slip_force_y, 0)),
+        jnp.where(sticking, force_x, jnp.where(slipping, slip.force_x, 0)),
+        jnp.where(sticking, force_y, jnp.where(slipping, slip.force_y, 0)),
     ], axis=-1)
-    length = jnp.sqrt(l2)
+    length = jnp.sqrt(guess.l2)
     residual = jnp.where(sticking, jnp.abs(stick_torque) / length, jnp.where(
-        slipping, jnp.maximum(jnp.abs(slip_force_x * ex + slip_force_y * ey), jnp.abs(slip_torque) / length), 0))
+        slipping, jnp.maximum(jnp.abs(slip.force_x * slip.ex + slip.force_y * slip.ey), jnp.abs(slip.torque) / length),
+        0))
     return Solution(twist, force, sticking, slipping, jax.lax.stop_gradient(residual))
 
 

@@ -33,6 +33,10 @@ Tracking effects model the motion-capture system and apply to the RECORDED objec
 
 Command-line syntax (:meth:`Effects.parse`): ``name=value`` items separated by ``;``, vector components by
 ``,``, e.g. ``com_offset=0.01,0.0;table_tilt_deg=1.0;pusher_friction=0.5``.
+
+One physics, three vocabularies: these effects, the testbed profile's mechanisms (:class:`pushjax.sim.testbed.Testbed`)
+and the pushing model's effects (:data:`pushjax.physics.effects.EFFECTS`) name the same physics differently (recorded
+manifests and the ``--effects`` syntax keep the testbed's names). :data:`MODEL_EFFECT` is the one translation.
 """
 
 from __future__ import annotations
@@ -43,6 +47,38 @@ import math
 from typing import Any
 
 _VECTOR_SIZES = {"com_offset": 2, "friction_anisotropy": 2, "tracking_noise": 2, "tracking_bias": 3}
+
+MODEL_EFFECT: dict[str, str | None] = {
+    # Effects (injected).
+    "com_offset": "cof_offset",  # the moved centre of mass moves the support's centre of pressure
+    "pressure_rim": "limit_surface",  # its rim parameter: the same exp(k rho) pressure over the footprint
+    "friction_anisotropy": "anisotropic_friction",
+    "table_tilt_deg": "table_tilt",  # with the azimuth, the drift force tan(tilt) / mu_surface downhill
+    "table_tilt_azimuth_deg": "table_tilt",
+    "pusher_friction": "pusher_friction",  # a scale of the nominal coefficient
+    "tracking_noise": None,  # sensor noise: the loop's noise floor, not an effect
+    "tracking_bias": "frame_offset",  # its (dx, dy); no effect turns the annotated outline (dyaw)
+    # Testbed (pushjax.sim.testbed), drawn per surface, object or push.
+    "pressure_plate_sigma": "limit_surface",  # an uneven load over the footprint: the exact surface of a pressure
+    # The table's load is realised as the friction field is, the supports' coefficients where they are on the table:
+    # a centre of friction that moves with the object. A field's correlation length belongs to its mechanism.
+    "pressure_table_sigma": "friction_field",
+    "pressure_table_length": "friction_field",
+    "friction_field_sigma": "friction_field",
+    "friction_field_length": "friction_field",
+    "object_friction_sigma": None,  # a uniform scale of the support friction cancels in quasi-static pushing
+    "friction_speed_gain": "friction_speed",
+    "pusher_friction_sigma": None,  # a push-to-push spread: pushjax.loop.variability, not an effect
+    "tracking_noise_xy": None,
+    "tracking_noise_yaw": None,
+    "timestamp_jitter": None,
+    "drop_rate": None,
+}
+"""The testbed's names for the physics (every :class:`Effects` field and every
+:class:`pushjax.sim.testbed.Testbed` field) -> the pushing model's effect (a key of
+:data:`pushjax.physics.effects.EFFECTS`) that models it, or None where no effect does (checked both ways by
+``tests/sim/test_vocabulary.py``). The one translation between the two vocabularies; ARCHITECTURE.md ("One physics,
+three places") shows it as a table."""
 
 
 @dataclasses.dataclass(frozen=True)

@@ -75,7 +75,7 @@ import shapely
 
 from pushjax.geometry.objects import PUSHER_RADIUS, PushObject, footprint_grid, get_object
 from pushjax.sim.effects import Effects
-from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION, get_surface
+from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION, Surface, get_surface
 
 TIMESTEP = 2e-3
 """Default simulation step in s (the step of slow pushes; ``pushjax.sim.push`` sets it per push)."""
@@ -307,14 +307,25 @@ def scene_spec(obj: PushObject | str, surface: str, effects: Effects = Effects()
     surface_spec = get_surface(surface)
     points, _ = support_points(obj, support)
     friction = support_friction(obj, surface, effects, support)
-    half_thickness = _written(obj.thickness / 2)
-    pusher_z = _written(PUSHER_CLEARANCE + PUSHER_HALF_HEIGHT)
-    pusher_size = _as_written([PUSHER_RADIUS, PUSHER_HALF_HEIGHT])
-    mu_pusher = pusher_friction(effects)
     pieces = convex_pieces(obj)
 
     spec = mujoco.MjSpec()
     spec.modelname = f"mit_push_{obj.name}_{surface}"
+    _set_options(spec, effects)
+    _add_assets(spec, obj, surface_spec)
+    world = spec.worldbody
+    world.add_light(name="top", pos=[0, 0, 1.5], dir=[0, 0, -1], diffuse=[0.6, 0.6, 0.6])
+    world.add_camera(name="camera", pos=[0, 0, 0.8], fovy=45)
+    world.add_geom(name="table", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[_written(TABLE_HALF_SIZE)] * 2 + [0.01],
+                   material="table_material", contype=0, conaffinity=0)
+    _add_plate(spec, obj, effects, pieces, points)
+    _add_pusher(spec)
+    _add_contacts(spec, friction, len(pieces), pusher_friction(effects))
+    return spec
+
+
+def _set_options(spec: mujoco.MjSpec, effects: Effects) -> None:
+    """The compiler's, the solver's (see the module docstring), the viewer's and the statistics' settings."""
     spec.compiler.degree = False
     spec.compiler.autolimits = True
     spec.option.timestep = _written(TIMESTEP)
@@ -331,6 +342,9 @@ def scene_spec(obj: PushObject | str, surface: str, effects: Effects = Effects()
     spec.stat.center = [0.0, 0.0, 0.02]
     spec.stat.extent = 0.4
 
+
+def _add_assets(spec: mujoco.MjSpec, obj: PushObject, surface_spec: Surface) -> None:
+    """The table's texture and material, the plate's and the pusher's materials and the plate's visual mesh."""
     spec.add_texture(name="table_texture", type=mujoco.mjtTexture.mjTEXTURE_2D,
                      builtin=getattr(mujoco.mjtBuiltin, f"mjBUILTIN_{surface_spec.texture.upper()}"),
                      mark=getattr(mujoco.mjtMark, f"mjMARK_{surface_spec.mark.upper()}"), random=0.05,
@@ -344,13 +358,13 @@ def scene_spec(obj: PushObject | str, surface: str, effects: Effects = Effects()
     spec.add_mesh(name="object_visual", uservert=_as_written(obj.mesh.vertices),
                   userface=np.ravel(obj.mesh.faces).astype(int).tolist())
 
-    world = spec.worldbody
-    world.add_light(name="top", pos=[0, 0, 1.5], dir=[0, 0, -1], diffuse=[0.6, 0.6, 0.6])
-    world.add_camera(name="camera", pos=[0, 0, 0.8], fovy=45)
-    world.add_geom(name="table", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[_written(TABLE_HALF_SIZE)] * 2 + [0.01],
-                   material="table_material", contype=0, conaffinity=0)
 
-    plate = world.add_body(name="object", pos=[0, 0, half_thickness])
+def _add_plate(spec: mujoco.MjSpec, obj: PushObject, effects: Effects, pieces: tuple[np.ndarray, ...],
+               points: np.ndarray) -> None:
+    """The body ``object``: its free joint, mass and inertia (centre of mass moved by ``Effects.com_offset``), visual
+    mesh, walls (one prism per convex piece) and support capsules at ``points``."""
+    half_thickness = _written(obj.thickness / 2)
+    plate = spec.worldbody.add_body(name="object", pos=[0, 0, half_thickness])
     plate.add_freejoint(name="object_joint")
     inertia = obj.inertia_tensor
     plate.explicitinertial = True
@@ -377,6 +391,13 @@ def scene_spec(obj: PushObject | str, surface: str, effects: Effects = Effects()
                        pos=_as_written(lower_end_centre + SUPPORT_HALF_LENGTH * axis), quat=capsule_quat, group=3,
                        contype=0, conaffinity=0, mass=0, rgba=[0.2, 0.8, 0.2, 1])
 
+
+def _add_pusher(spec: mujoco.MjSpec) -> None:
+    """The mocap body ``pusher`` (rendering only), the carriage ``pusher_carriage`` on its slide joints with the tip
+    ``pusher_tip`` on its vertical spring, and the carriage's position and velocity servos."""
+    world = spec.worldbody
+    pusher_z = _written(PUSHER_CLEARANCE + PUSHER_HALF_HEIGHT)
+    pusher_size = _as_written([PUSHER_RADIUS, PUSHER_HALF_HEIGHT])
     world.add_body(name="pusher", mocap=True, pos=[0, 0, pusher_z]).add_geom(
         name="pusher", type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[*pusher_size, 0.0], material="pusher_material",
         contype=0, conaffinity=0)
@@ -398,18 +419,21 @@ def scene_spec(obj: PushObject | str, surface: str, effects: Effects = Effects()
         spec.add_actuator(name=f"pusher_v{axis_name}", target=f"pusher_{axis_name}",
                           trntype=mujoco.mjtTrn.mjTRN_JOINT).set_to_velocity(kv=_written(PUSHER_KV))
 
-    for k in range(len(points)):
+
+def _add_contacts(spec: mujoco.MjSpec, friction: np.ndarray, walls: int, mu_pusher: float) -> None:
+    """The explicit contact pairs (table–support with the supports' [K, 2] ``friction``, tip–wall with ``mu_pusher``)
+    and the pusher's contact sensor."""
+    for k in range(len(friction)):
         spec.add_pair(geomname1="table", geomname2=f"support{k}", condim=3, solref=_as_written(CONTACT_SOLREF),
                       solimp=_as_written(SUPPORT_SOLIMP),
                       friction=_as_written([friction[k, 0], friction[k, 1], TORSIONAL_FRICTION, 0, 0]))
-    for k in range(len(pieces)):
+    for k in range(walls):
         spec.add_pair(geomname1="pusher_tip", geomname2=f"wall{k}", condim=3, solref=_as_written(CONTACT_SOLREF),
                       solimp=_as_written(PUSHER_SOLIMP),
                       friction=_as_written([mu_pusher, mu_pusher, TORSIONAL_FRICTION, 0, 0]))
     spec.add_sensor(name="pusher_contact", type=mujoco.mjtSensor.mjSENS_CONTACT, objtype=mujoco.mjtObj.mjOBJ_BODY,
                     objname="pusher_tip", reftype=mujoco.mjtObj.mjOBJ_BODY, refname="object",
                     intprm=[_CONTACT_DATA, _CONTACT_NETFORCE, 1])
-    return spec
 
 
 def scene_xml(obj: PushObject | str, surface: str, effects: Effects = Effects(), support: str = "grid") -> str:

@@ -7,7 +7,8 @@ distributions per surface, per object or per push (:func:`draw_conditions`), so 
 deterministic and resumable. Whatever the profile, the simulated plate has mass and inertia: it keeps sliding after
 the pusher lets go, the more the faster it was pushed (``pushjax.sim.push``), which the quasi-static model ignores.
 
-Mechanisms and their :class:`Testbed` fields (0 switches a mechanism off; :data:`IDEAL` has every field at 0):
+Mechanisms and their :class:`Testbed` fields (0 switches a mechanism off; :data:`IDEAL` has every field at 0; the
+pushing model's effect for each field: :data:`pushjax.sim.effects.MODEL_EFFECT`):
 
 Support pressure (``pressure_*``)
     A plate on a real table rests on a few high points of both faces, not on a uniform pressure. The support
@@ -93,16 +94,11 @@ from typing import Any
 
 import numpy as np
 
+from pushjax.friction import MIN_FRICTION_FACTOR, SPEED_FLOOR, SPEED_REFERENCE
 from pushjax.sim.effects import as_float, from_fields, parse_assignments
 
 FIELD_FEATURES = 64
 """Random Fourier features of each smooth random field."""
-SPEED_REFERENCE = 0.02
-"""Sliding speed in m/s at which the speed-dependent coefficient equals the nominal one (the MIT grid's 20 mm/s)."""
-SPEED_FLOOR = 1e-3
-"""Sliding speed in m/s below which the speed-dependent coefficient no longer changes (static contact)."""
-MIN_FRICTION_FACTOR = 0.1
-"""Smallest factor of the speed-dependent coefficient."""
 
 _POSITIVE_LENGTHS = ("pressure_table_length", "friction_field_length")
 _UNIT_INTERVAL = ("drop_rate",)

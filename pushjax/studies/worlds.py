@@ -1,5 +1,6 @@
 """Worlds of the studies: the realistic testbed with one effect the controller's model does not declare, its
-magnitude drawn from the world's seed (:func:`draw_world`, :data:`EFFECTS`), and the oracle model that knows it:
+magnitude drawn from the world's seed (:func:`draw_world`, :data:`EFFECTS`), and the oracle model that knows it (the
+model's effect named by :data:`pushjax.sim.effects.MODEL_EFFECT`):
 
 ``tilt``                  the table tilted by 2-4 degrees towards a uniform azimuth (``Effects.table_tilt_deg``);
 ``com_offset``            the centre of mass moved by 30-50 % of the distance from the centroid to the outline, in a
@@ -22,7 +23,7 @@ import shapely
 
 from pushjax.geometry.objects import get_object
 from pushjax.physics.model_file import AugmentedModel
-from pushjax.sim.effects import Effects
+from pushjax.sim.effects import MODEL_EFFECT, Effects
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION, get_surface
 from pushjax.sim.testbed import REALISTIC, Testbed
 
@@ -72,14 +73,15 @@ def draw_world(effect: str, seed: int, objects: Sequence[str], surface: str = "a
         tilt, azimuth = rng.uniform(*TILT_DEG), rng.uniform(0.0, 360.0)
         drift = math.tan(math.radians(tilt)) / get_surface(surface).object_friction
         downhill = [drift * math.cos(math.radians(azimuth)), drift * math.sin(math.radians(azimuth))]
-        oracle = AugmentedModel.create(("table_tilt",), {"table_tilt": {"drift_force": downhill}},
+        model_effect = MODEL_EFFECT["table_tilt_deg"]
+        oracle = AugmentedModel.create((model_effect,), {model_effect: {"drift_force": downhill}},
                                        PUSHER_OBJECT_FRICTION)
         return World(effect, seed, {"tilt_deg": tilt, "azimuth_deg": azimuth, "drift_force": downhill},
                      {obj: Effects(table_tilt_deg=tilt, table_tilt_azimuth_deg=azimuth) for obj in objects}, testbed,
                      {obj: oracle for obj in objects})
     if effect == "com_offset":
         share, direction = rng.uniform(*COM_OFFSET_SHARE), rng.uniform(-math.pi, math.pi)
-        offsets = {}
+        offsets, model_effect = {}, MODEL_EFFECT["com_offset"]
         for obj in objects:
             shape = get_object(obj)
             inside = shape.polygon.exterior.distance(shapely.Point(*shape.centroid))
@@ -87,7 +89,7 @@ def draw_world(effect: str, seed: int, objects: Sequence[str], surface: str = "a
         return World(effect, seed, {"share_of_inradius": share, "direction_deg": math.degrees(direction),
                                     "offset_m": offsets},
                      {obj: Effects(com_offset=offsets[obj]) for obj in objects}, testbed,
-                     {obj: AugmentedModel.create(("cof_offset",), {"cof_offset": {"offset": offsets[obj]}},
+                     {obj: AugmentedModel.create((model_effect,), {model_effect: {"offset": offsets[obj]}},
                                                  PUSHER_OBJECT_FRICTION) for obj in objects})
     if effect == "pusher_friction":
         mu = rng.uniform(*PUSHER_FRICTION)
