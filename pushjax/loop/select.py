@@ -319,26 +319,41 @@ def select_effects(
         if not sets:
             break
         report(f"fitting {current.effects} plus one of {len(sets)} effects, and {current.effects} further")
-        starts = [[{**{name: current.fits[k].params[name] for name in effects_set if name in current.effects},
-                    name: single_params[k][name]} for effects_set, name in zip(sets, additions)]
-                  for k in range(len(folds.fit))]
-        for continuations in range(MAX_CONTINUATIONS + 1):
-            per_fold = [fit_lib.fit_effects(sets + [current.effects], fit, settings,
-                                            initial=starts[k] + [current.fits[k].params])
-                        for k, fit in enumerate(folds.fit)]
-            *candidates, continued = folds.evaluate(sets + [current.effects], per_fold)
-            incumbent_change = (current.score - continued.score) / max(current.score, np.finfo(float).tiny)
-            current = continued
-            if incumbent_change <= CONVERGENCE_TOLERANCE or continuations == MAX_CONTINUATIONS:
-                break
-            report(f"continuing the fits of {current.effects} and its candidates (not converged)")
-            starts = [[candidate.fits[k].params for candidate in candidates] for k in range(len(folds.fit))]
+        candidates, current, incumbent_change, continuations = _fit_round(folds, current, sets, additions,
+                                                                          single_params, settings, report)
     model = None
     if current.effects:
         report(f"refitting {current.effects} on every pool sequence")
         model = fit_lib.fit_effects([current.effects], split.pool, settings, initial=[current.fits[0].params])[0]
     return Selection(baseline=baseline, ranking=ranking, rounds=rounds, final=current, model=model,
                      noise_floor=floor)
+
+
+def _fit_round(folds: _Folds, current: Candidate, sets: list[tuple[str, ...]], additions: list[str],
+               single_params: list[dict], settings: fit_lib.FitConfig, report: Callable[[str], None]
+               ) -> tuple[list[Candidate], Candidate, float, int]:
+    """Fits a round's candidate sets, each warm-started from the current fit and its added effect's single fit, with
+    the current set continued beside them, and continues them all while the current one's score still changes.
+
+    Returns:
+      (the candidates, the current set fitted as far as them, the share of its score the last continuation removed,
+      the number of continuations).
+    """
+    starts = [[{**{name: current.fits[k].params[name] for name in effects_set if name in current.effects},
+                name: single_params[k][name]} for effects_set, name in zip(sets, additions)]
+              for k in range(len(folds.fit))]
+    for continuations in range(MAX_CONTINUATIONS + 1):
+        per_fold = [fit_lib.fit_effects(sets + [current.effects], fit, settings,
+                                        initial=starts[k] + [current.fits[k].params])
+                    for k, fit in enumerate(folds.fit)]
+        *candidates, continued = folds.evaluate(sets + [current.effects], per_fold)
+        incumbent_change = (current.score - continued.score) / max(current.score, np.finfo(float).tiny)
+        current = continued
+        if incumbent_change <= CONVERGENCE_TOLERANCE or continuations == MAX_CONTINUATIONS:
+            break
+        report(f"continuing the fits of {current.effects} and its candidates (not converged)")
+        starts = [[candidate.fits[k].params for candidate in candidates] for k in range(len(folds.fit))]
+    return candidates, current, incumbent_change, continuations
 
 
 def check_mechanism(pool: Examples, effects: tuple[str, ...], added: str, settings: fit_lib.FitConfig,

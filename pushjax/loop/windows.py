@@ -257,7 +257,13 @@ def build_examples(
         reasons = ", ".join(f"{reason}: {len(names)}" for reason, names in skipped.items()) or "no pushes"
         raise ValueError(f"pushes: none gave a prediction window of {horizon} s ({reasons})")
 
-    parts = [_annotate_object(name, object_rows, pusher_friction) for name, object_rows in sorted(rows.items())]
+    examples = _merge([_annotate_object(name, object_rows, pusher_friction)
+                       for name, object_rows in sorted(rows.items())], tuple(sequence_index))
+    return examples, BuildSummary(n_pushes=n_pushes, skipped=dict(skipped))
+
+
+def _merge(parts: list[dict], sequence_names: tuple[str, ...]) -> Examples:
+    """The examples of every object's annotated windows in one set."""
     # Objects' supports have different numbers of points: padded with zero-weight points to the largest.
     cells = max(part["support_points"].shape[1] for part in parts)
     for part in parts:
@@ -268,12 +274,10 @@ def build_examples(
     merged = {key: np.concatenate([part[key] for part in parts]) for key in parts[0] if key != "variables"}
     variables = {name: np.concatenate([part["variables"][name] for part in parts]) for name in VARIABLES}
     inputs = PushInputs(**{field.name: merged[field.name] for field in dataclasses.fields(PushInputs)})
-    examples = Examples(inputs=inputs, target=merged["target"], sequence=merged["sequence"], push=merged["push"],
-                        window=merged["window"], tracking_noise=merged["tracking_noise"],
-                        push_friction=merged["push_friction"], push_friction_std=merged["push_friction_std"],
-                        wrench=merged["wrench"], variables=variables,
-                        sequence_names=tuple(sequence_index))
-    return examples, BuildSummary(n_pushes=n_pushes, skipped=dict(skipped))
+    return Examples(inputs=inputs, target=merged["target"], sequence=merged["sequence"], push=merged["push"],
+                    window=merged["window"], tracking_noise=merged["tracking_noise"],
+                    push_friction=merged["push_friction"], push_friction_std=merged["push_friction_std"],
+                    wrench=merged["wrench"], variables=variables, sequence_names=sequence_names)
 
 
 def _annotate_object(name: str, rows: list[dict], pusher_friction: float) -> dict:
