@@ -19,6 +19,7 @@ import tqdm
 from pushjax.loop import correction as correction_lib
 from pushjax.loop import diagnose as diagnose_lib
 from pushjax.loop import force as force_lib
+from pushjax.loop import figures as figures_lib
 from pushjax.loop import fit as fit_lib
 from pushjax.loop import hierarchy as hierarchy_lib
 from pushjax.loop import metrics
@@ -370,9 +371,9 @@ def _write(workdir: Path, result: report_lib.LoopResult, decision: Decision) -> 
     figures.mkdir(parents=True, exist_ok=True)
     report_lib.write(workdir, result)
     selection_windows = decision.split.pool.select(decision.split.select_index)
-    report_lib.residual_figure(figures / "residual_baseline.png", selection_windows, selection.baseline.prediction,
+    figures_lib.residual_figure(figures / "residual_baseline.png", selection_windows, selection.baseline.prediction,
                                "Residual of the plain model (median per bin)", decision.variables)
-    report_lib.residual_figure(figures / "residual_after.png", selection_windows, selection.final.prediction,
+    figures_lib.residual_figure(figures / "residual_after.png", selection_windows, selection.final.prediction,
                                "Residual after the fix: " + (" + ".join(selection.selected) or "nothing selected"),
                                decision.variables)
-    report_lib.strength_figure(figures / "diagnosis.png", decision.diagnosis_before, decision.diagnosis_after)
+    figures_lib.strength_figure(figures / "diagnosis.png", decision.diagnosis_before, decision.diagnosis_after)
