@@ -12,6 +12,7 @@ and the exit status `USAGE_ERROR_STATUS` (2), instead of absl's help text (dozen
 
 import re
 import sys
+from collections.abc import Mapping
 from typing import NoReturn
 
 from absl import app, flags
@@ -86,6 +87,13 @@ def run(main) -> None:
             exit_usage_error(str(error))
 
     app.run(main_with_one_line_usage_errors, flags_parser=parse_flags_or_exit)
+
+
+def config_error(error: ValueError, flag_names: Mapping[str, str] | None = None) -> app.UsageError:
+    """A study config's ValueError, ``<field>: <what was expected>``, as the usage error of the flag that sets the
+    field, ``--<flag>: <what was expected>`` (`flag_names`: {field: flag name} where the two differ)."""
+    field, colon, expected = " ".join(str(error).split()).partition(":")
+    return app.UsageError(f"--{(flag_names or {}).get(field, field)}{colon}{expected}")
 
 
 def require_writable_folder(flag_name: str) -> None:

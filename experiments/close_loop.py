@@ -49,8 +49,7 @@ def main(argv):
                               min_strength=_MIN_STRENGTH.value, effects=tuple(_EFFECTS.value),
                               fit=dataclasses.replace(FitConfig(), steps=_STEPS.value))
     except ValueError as error:
-        field, expected = str(error).split(":", 1)
-        raise app.UsageError(f"--{_FLAG_OF_FIELD.get(field, field)}:{expected}") from None
+        raise experiments.config_error(error, _FLAG_OF_FIELD) from None
     try:
         result = close_loop(_DATA_DIR.value, _WORKDIR.value, settings, seed=_SEED.value)
     except ValueError as error:

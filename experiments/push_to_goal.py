@@ -24,6 +24,7 @@ are added to a finished run in the same work folder): the verdict then needs Poc
 (``pushjax.stats.decide``).
 """
 
+import dataclasses
 import math
 
 from absl import app, flags
@@ -32,7 +33,6 @@ import experiments
 from pushjax import stats
 from pushjax.control import mpc
 from pushjax.data import configs as data_configs
-from pushjax.geometry.objects import OBJECT_NAMES
 from pushjax.sensing import perception
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
@@ -75,24 +75,9 @@ NOISE_PUSHES = 1
 """Pushes per object, simulated with seed --seed + 1, on which the perception's noise is estimated."""
 
 
-@flags.validator("max_time", "expected a finite number of seconds >= 1")
-def _check_max_time(value):
-    return value is None or math.isfinite(value)
-
-
 @flags.validator("perception_gate", "expected a finite chi-square bound > 0")
 def _check_gate(value):
     return value is None or math.isfinite(value)
-
-
-@flags.validator("objects", f"expected a non-empty list from {','.join(OBJECT_NAMES)}, no repeats")
-def _check_objects(values):
-    return values is None or (bool(values) and len(set(values)) == len(values) and set(values) <= set(OBJECT_NAMES))
-
-
-@flags.validator("planners", f"expected a non-empty list from {','.join(mpc.PLANNERS)}, no repeats")
-def _check_planners(values):
-    return values is None or (bool(values) and len(set(values)) == len(values) and set(values) <= set(mpc.PLANNERS))
 
 
 def _parsed_by(parse):
@@ -108,64 +93,64 @@ def _parsed_by(parse):
     return check
 
 
-def _parse_models(names):
-    if not names:
-        raise ValueError("expected at least one model")
-    return [push_to_goal.model_effects(name) for name in names]
-
-
-flags.register_validator("models", _parsed_by(_parse_models))
 flags.register_multi_flags_validator(
     ["models", "loop_model"], lambda values: (push_to_goal.LOOP_MODEL in values["models"]) == bool(values["loop_model"]),
     f"--loop_model: expected exactly when --models has '{push_to_goal.LOOP_MODEL}'")
-flags.register_validator("effect_params", _parsed_by(push_to_goal.parse_effect_params))
-flags.register_validator(
-    "states", lambda values: bool(values) and len(set(values)) == len(values)
-    and set(values) <= set(episode.STATE_SOURCES),
-    f"expected a non-empty list from {','.join(episode.STATE_SOURCES)}, no repeats")
 flags.register_multi_flags_validator(
     ["states", "perception"], lambda values: any("perception" in state for state in values["states"])
     == bool(values["perception"]), "--perception: expected exactly when --states has a state with perception")
 flags.register_validator("effects", _parsed_by(Effects.parse))
+FLAG_NAMES = {"goals_per_object": "goals", "setup.max_time": "max_time"}
+"""The flags of the config's fields that are named otherwise (``experiments.config_error``)."""
 
 
 def main(argv):
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
     testbed = experiments.testbed_from_flags(_TESTBED.value, _TESTBED_OVERRIDES.value)
-    scale = push_to_goal.SCALES[_SCALE.value]
-    setup = episode.EpisodeConfig(max_time=_MAX_TIME.value or scale["max_time"], surface=_SURFACE.value,
-                                  testbed=testbed, effects=Effects.parse(_EFFECTS.value))
-    objects = _OBJECTS.value or scale["objects"]
     for name in ("perception_scale", "perception_every", "perception_gate"):
         if flags.FLAGS[name].present and _PERCEPTION.value is None:
             raise app.UsageError(f"--{name}: only used with --perception, which is not given")
-    position, position_settings = None, None
-    if _PERCEPTION.value is not None:
-        try:
-            sensor = perception.load_data_efficiency(_PERCEPTION.value, _PERCEPTION_SCALE.value)
-        except ValueError as error:
-            raise app.UsageError(f"--perception: {' '.join(str(error).split())}") from None
-        period = scale["controller"].period
-        noise_seed = _SEED.value + tracking.TRAINING_SEED_OFFSET
-        noise_pushes = tracking.simulate_pushes(objects, NOISE_PUSHES, noise_seed, testbed, 1.0 / period)
-        noise = perception.estimate_noise(sensor, noise_pushes, _PERCEPTION_EVERY.value)
-        position = episode.PositionSource(sensor.locate, tuple(max(v, 1e-5) for v in noise["std"]),
-                                          _PERCEPTION_EVERY.value, sensor.description, _PERCEPTION_GATE.value)
-        position_settings = {"model": _PERCEPTION.value, "dataset": f"data_efficiency/{_PERCEPTION_SCALE.value}",
-                             "noise_seed": noise_seed, "noise_bias_m": noise["bias"], "noise_rmse_m": noise["rmse"],
-                             "noise_readings": noise["readings"], "noise_pushes": noise["pushes"]}
     try:
-        results = push_to_goal.run(_WORKDIR.value, objects, _GOALS.value or scale["goals"], _MODELS.value,
-                                   _PLANNERS.value or scale["planners"], _SEED.value, setup, _EFFECT_PARAMS.value,
-                                   scale["controller"], _LOOP_MODEL.value, _STATES.value, position, position_settings,
-                                   _LOOKS.value)
+        config = push_to_goal.PushToGoalConfig.from_scale(
+            _SCALE.value, objects=_OBJECTS.value, goals_per_object=_GOALS.value, models=_MODELS.value,
+            planners=_PLANNERS.value, seed=_SEED.value, effect_params=_EFFECT_PARAMS.value,
+            loop_model=_LOOP_MODEL.value, looks=_LOOKS.value, max_time=_MAX_TIME.value, surface=_SURFACE.value,
+            testbed=testbed, effects=Effects.parse(_EFFECTS.value))
+    except ValueError as error:
+        raise experiments.config_error(error, FLAG_NAMES) from None
+    position = _position(config) if _PERCEPTION.value is not None else {}
+    try:
+        config = dataclasses.replace(config, states=tuple(_STATES.value), **position)
+    except ValueError as error:
+        raise experiments.config_error(error, FLAG_NAMES) from None
+    try:
+        results = push_to_goal.run(config, _WORKDIR.value)
     except push_to_goal.ModelFileError as error:
         raise app.UsageError(f"--loop_model: {error}") from None
-    results["settings"]["scale"] = _SCALE.value
     paths = push_to_goal.write(results, _WORKDIR.value)
     print(paths[1].read_text())
     print(f"wrote {', '.join(str(path) for path in paths)}")
+
+
+def _position(config: push_to_goal.PushToGoalConfig) -> dict:
+    """The ``--perception`` model's readings as `config`'s position source and what identifies it: its noise estimated
+    on `NOISE_PUSHES` pushes per object simulated with the config's seed + 1, not on the evaluated episodes."""
+    try:
+        sensor = perception.load_data_efficiency(_PERCEPTION.value, _PERCEPTION_SCALE.value)
+    except ValueError as error:
+        raise app.UsageError(f"--perception: {' '.join(str(error).split())}") from None
+    noise_seed = config.seed + tracking.TRAINING_SEED_OFFSET
+    noise_pushes = tracking.simulate_pushes(config.objects, NOISE_PUSHES, noise_seed, config.setup.testbed,
+                                            1.0 / config.controller.period)
+    noise = perception.estimate_noise(sensor, noise_pushes, _PERCEPTION_EVERY.value)
+    position = episode.PositionSource(sensor.locate, tuple(max(v, 1e-5) for v in noise["std"]),
+                                      _PERCEPTION_EVERY.value, sensor.description, _PERCEPTION_GATE.value)
+    return {"position": position,
+            "position_settings": {"model": _PERCEPTION.value, "dataset": f"data_efficiency/{_PERCEPTION_SCALE.value}",
+                                  "noise_seed": noise_seed, "noise_bias_m": noise["bias"],
+                                  "noise_rmse_m": noise["rmse"], "noise_readings": noise["readings"],
+                                  "noise_pushes": noise["pushes"]}}
 
 
 if __name__ == "__main__":

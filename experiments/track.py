@@ -22,8 +22,8 @@ again) and writes to ``--workdir`` the filters' position errors per seed and the
 of every seed but the one the process noise was tuned on (``pushjax.studies.tracking.compare_over_seeds``).
 """
 
+import dataclasses
 import json
-import math
 from pathlib import Path
 
 from absl import app, flags
@@ -58,21 +58,6 @@ _PERCEPTION_SCALE = flags.DEFINE_enum("perception_scale", "cpu", list(data_confi
 experiments.require_writable_folder("workdir")
 
 
-@flags.validator("filters", "expected a non-empty list of known filters, no repeats")
-def _check_filters(values):
-    return bool(values) and len(set(values)) == len(values) and all(v in tracking.FILTERS for v in values)
-
-
-@flags.validator("rate_hz", f"expected {tracking.RECORDING_RATE_HZ} Hz divided by a whole number")
-def _check_rate(value):
-    if value is None:
-        return True
-    if not (math.isfinite(value) and 0 < value <= tracking.RECORDING_RATE_HZ):
-        return False
-    step = tracking.RECORDING_RATE_HZ / value
-    return abs(step - round(step)) < 1e-9
-
-
 @flags.validator("seeds", "expected distinct seeds >= 0, at least one of them not the tuning seed "
                           f"{tracking.TUNING_SEED}")
 def _check_seeds(values):
@@ -83,37 +68,27 @@ def _check_seeds(values):
     return any(int(value) != tracking.TUNING_SEED for value in values)
 
 
-@flags.validator("learn_steps", "expected a whole number of steps >= 1")
-def _check_learn_steps(value):
-    return value is None or value >= 1
-
-
 def main(argv):
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
     if _SEEDS.value is not None and flags.FLAGS["seed"].present:
         raise app.UsageError("--seed: give --seed or --seeds, not both")
     testbed = experiments.testbed_from_flags(_TESTBED.value, _TESTBED_OVERRIDES.value)
-    scale = tracking.SCALES[_SCALE.value]
-    rate = _RATE.value or scale["rate_hz"]
-    learns = "ekf_learned" in _FILTERS.value
-    if _LEARN_STEPS.value is not None and not learns:
+    if _LEARN_STEPS.value is not None and "ekf_learned" not in _FILTERS.value:
         raise app.UsageError("--learn_steps: only used by ekf_learned, which --filters leaves out")
     for name in ("perception_hz", "perception_scale"):
         if flags.FLAGS[name].present and _PERCEPTION.value is None:
             raise app.UsageError(f"--{name}: only used with --perception, which is not given")
-    every = rate / _PERCEPTION_HZ.value
-    if _PERCEPTION.value is not None and not (_PERCEPTION_HZ.value > 0 and abs(every - round(every)) < 1e-9):
-        raise app.UsageError(f"--perception_hz: expected the filter rate {rate:g} Hz divided by a whole number, got "
-                             f"{_PERCEPTION_HZ.value:g}")
-    sensor = None
-    if _PERCEPTION.value is not None:
-        try:
-            sensor = perception.load_data_efficiency(_PERCEPTION.value, _PERCEPTION_SCALE.value)
-        except ValueError as error:
-            raise app.UsageError(f"--perception: {' '.join(str(error).split())}") from None
+    try:
+        config = tracking.TrackingConfig.from_scale(
+            _SCALE.value, filters=_FILTERS.value, rate_hz=_RATE.value, learn_steps=_LEARN_STEPS.value,
+            seed=_SEED.value, testbed=testbed, perception_hz=_PERCEPTION_HZ.value)
+        if _PERCEPTION.value is not None:
+            config = dataclasses.replace(config, perception=_sensor())
+    except ValueError as error:
+        raise experiments.config_error(error) from None
     if _SEEDS.value is None:
-        paths = tracking.write(_run_seed(_SEED.value, testbed, rate, sensor, round(every)), _WORKDIR.value)
+        paths = tracking.write(tracking.run(config, _WORKDIR.value), _WORKDIR.value)
         print(paths[1].read_text())
         print(f"wrote {', '.join(str(path) for path in paths)}")
         return
@@ -127,7 +102,7 @@ def main(argv):
                                      f"--workdir")
             print(f"seed {seed}: read {folder / 'results.json'}")
         else:
-            record = _run_seed(seed, testbed, rate, sensor, round(every))
+            record = tracking.run(dataclasses.replace(config, seed=seed), folder)
             tracking.write(record, folder)
         records.append(record)
     comparison = tracking.compare_over_seeds(records)
@@ -138,24 +113,12 @@ def main(argv):
     print(f"wrote {', '.join(str(path) for path in paths)}")
 
 
-def _run_seed(seed: int, testbed, rate: float, sensor, every: int) -> dict:
-    """The results of :func:`pushjax.studies.tracking.run` on the pushes of `seed` at the flags' scale and filters."""
-    scale = tracking.SCALES[_SCALE.value]
-    learns = "ekf_learned" in _FILTERS.value
-    pushes = tracking.simulate_pushes(scale["objects"], scale["pushes"], seed, testbed, rate)
-    training_seed = seed + tracking.TRAINING_SEED_OFFSET
-    training_pushes = (tracking.simulate_pushes(scale["objects"], scale["pushes"], training_seed, testbed, rate)
-                       if learns or sensor is not None else [])
-    readings = (perception.stream(sensor, pushes, training_pushes, every, rate, training_seed)
-                if sensor is not None else None)
-    measurement_std = (max(testbed.tracking_noise_xy, 1e-5), max(testbed.tracking_noise_xy, 1e-5),
-                       max(testbed.tracking_noise_yaw, 1e-4))
-    results = tracking.run(pushes, _FILTERS.value, rate, scale["particles"], seed, measurement_std,
-                           training_pushes if learns else (), _LEARN_STEPS.value or scale["learn_steps"], readings)
-    results.update(scale=_SCALE.value, seed=seed, testbed=testbed.to_dict())
-    if learns or sensor is not None:
-        results.update(training_seed=training_seed)
-    return results
+def _sensor() -> perception.PerceptionSensor:
+    """The ``--perception`` model's perception (a usage error naming the flag when it cannot be loaded)."""
+    try:
+        return perception.load_data_efficiency(_PERCEPTION.value, _PERCEPTION_SCALE.value)
+    except ValueError as error:
+        raise app.UsageError(f"--perception: {' '.join(str(error).split())}") from None
 
 
 if __name__ == "__main__":

@@ -16,10 +16,11 @@ state source, e.g. ``lynch (mocap + perception)`` (:func:`label`), so that :func
 goals. Episodes are appended to ``episodes.jsonl`` in the work folder as they finish, keyed by the run's settings, so
 an interrupted run resumes where it stopped.
 
-The report: per episode rows (:func:`episode_row`), summaries per model and planner (and per object) with Wilson
-intervals and the paired comparisons over goals (:func:`summarise`, :func:`compare`), runs in several worlds pooled
-into one comparison (:func:`pool_worlds`); :func:`write` turns them into ``results.json``, a markdown table and a
-figure of trajectories. Units in the report: mm and degrees for errors, m for the pusher's path, s for times.
+A run is a :class:`PushToGoalConfig` (its scales :data:`SCALES`, :meth:`PushToGoalConfig.from_scale`), validated
+when made; :func:`run` runs it in a work folder. The report: per episode rows (:func:`episode_row`), summaries per
+model and planner (and per object) with Wilson intervals and the paired comparisons over goals (:func:`summarise`,
+:func:`compare`), runs in several worlds pooled into one comparison (:func:`pool_worlds`); :func:`write` turns them
+into ``results.json``, a markdown table and a figure of trajectories. Units in the report: mm and degrees for errors, m for the pusher's path, s for times.
 """
 
 from __future__ import annotations
@@ -44,20 +45,9 @@ from pushjax.physics import model_file
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
 from pushjax.studies import episode
 
-__all__ = ["LOOP_MODEL", "SCALES", "ModelFileError", "compare", "episode_row", "figure", "label", "model_effects",
-           "parse_effect_params", "pool_worlds", "run", "summarise", "table", "write"]
+__all__ = ["LOOP_MODEL", "SCALES", "ModelFileError", "PushToGoalConfig", "compare", "episode_row", "figure", "label",
+           "model_effects", "parse_effect_params", "pool_worlds", "run", "summarise", "table", "write"]
 
-SCALES = {
-    "smoke": {"objects": ("rect1",), "goals": 2, "planners": ("gradient",), "max_time": 30.0,
-              "controller": mpc.ControllerConfig(horizon=8, gradient=gradient.GradientConfig(iterations=15),
-                                                 candidates=16)},
-    "cpu": {"objects": OBJECT_NAMES, "goals": 2, "planners": ("gradient", "sampling"), "max_time": 60.0,
-            "controller": mpc.ControllerConfig()},
-    "full": {"objects": OBJECT_NAMES, "goals": 10, "planners": ("gradient", "sampling"), "max_time": 60.0,
-             "controller": mpc.ControllerConfig()},
-}
-"""Objects, goals per object, planners, simulated seconds per episode and controller settings of each scale (smoke:
-a shorter horizon, fewer planner iterations and contact candidates, which compile and plan faster)."""
 TRAJECTORY_STRIDE = 5
 """Control periods between the poses kept for the figure."""
 
@@ -116,6 +106,122 @@ def parse_effect_params(spec: str) -> dict[str, dict[str, np.ndarray]]:
     return params
 
 
+def _whole(name: str, value, least: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, int) or value < least:
+        raise ValueError(f"{name}: expected a whole number >= {least}, got {value!r}")
+
+
+def _names(name: str, values: tuple[str, ...], known: Sequence[str]) -> None:
+    if not values or len(set(values)) != len(values) or not set(values) <= set(known):
+        raise ValueError(f"{name}: expected a non-empty list from {','.join(known)}, no repeats, got "
+                         f"{','.join(values) or 'none'}")
+
+
+@dataclasses.dataclass(frozen=True)
+class PushToGoalConfig:
+    """What a run of the experiment does (:func:`run`); the scales' are :data:`SCALES` (:meth:`from_scale`).
+
+    Attributes:
+      objects: object names, from ``OBJECT_NAMES``, no repeats.
+      goals_per_object: goals per object (:func:`pushjax.control.goals.draw_goals`).
+      models: model names (:func:`model_effects`).
+      planners: planner names (:data:`pushjax.control.mpc.PLANNERS`), no repeats.
+      seed: seed of the goals, the testbed's draws and the controllers' keys.
+      setup: the :class:`~pushjax.studies.episode.EpisodeConfig` (testbed, world, surface, limits; ``max_time`` a
+        finite number of seconds >= 1).
+      effect_params: the models' effect parameters (:func:`parse_effect_params`).
+      controller: the controller's settings (``planner`` replaced by each of `planners`).
+      loop_model: the pushing model file of the ``loop`` model (needed when `models` has it; read by :func:`run`).
+      states: state sources from :data:`pushjax.studies.episode.STATE_SOURCES`, no repeats.
+      position: the position source of the states with ``perception`` (needed when `states` has one).
+      position_settings: what identifies `position` in the results' settings and the episodes' fingerprint (e.g. the
+        trained model, its dataset and the noise estimate; JSON-able).
+      looks: which look at the models' comparison this run is (:func:`pushjax.stats.decide`; not part of the
+        episodes' fingerprint, so a second look resumes the first's episodes).
+      scale: the name of the scale the config was made from (:meth:`from_scale`; recorded in the results' settings,
+        not part of the episodes' fingerprint), or None.
+
+    Raises:
+      ValueError: a field out of its range, naming it (``<field>: <what was expected>``; the setup's maximum time as
+        ``setup.max_time``); one line.
+    """
+
+    objects: tuple[str, ...]
+    goals_per_object: int
+    models: tuple[str, ...]
+    planners: tuple[str, ...]
+    seed: int
+    setup: episode.EpisodeConfig
+    effect_params: str = ""
+    controller: mpc.ControllerConfig = mpc.ControllerConfig()
+    loop_model: str | Path | None = None
+    states: tuple[str, ...] = ("mocap",)
+    position: episode.PositionSource | None = None
+    position_settings: dict | None = None
+    looks: int = 1
+    scale: str | None = None
+
+    def __post_init__(self):
+        for name in ("objects", "models", "planners", "states"):
+            object.__setattr__(self, name, tuple(getattr(self, name)))
+        _names("objects", self.objects, OBJECT_NAMES)
+        _whole("goals_per_object", self.goals_per_object, 1)
+        if not self.models:
+            raise ValueError("models: expected at least one model")
+        for name in self.models:
+            try:
+                model_effects(name)
+            except ValueError as error:
+                raise ValueError(f"models: {error}") from None
+        _names("planners", self.planners, tuple(mpc.PLANNERS))
+        _whole("seed", self.seed, 0)
+        max_time = self.setup.max_time
+        if not (isinstance(max_time, (int, float)) and math.isfinite(max_time) and max_time >= 1):
+            raise ValueError(f"setup.max_time: expected a finite number of seconds >= 1, got {max_time!r}")
+        try:
+            parse_effect_params(self.effect_params)
+        except ValueError as error:
+            raise ValueError(f"effect_params: {error}") from None
+        if LOOP_MODEL in self.models and self.loop_model is None:
+            raise ValueError(f"loop_model: the model {LOOP_MODEL!r} needs a pushing model file")
+        _names("states", self.states, episode.STATE_SOURCES)
+        if any("perception" in state for state in self.states) and self.position is None:
+            raise ValueError("position: the state sources with perception need a position source")
+        if self.looks not in stats.SEQUENTIAL_STANDARD_ERRORS:
+            raise ValueError(f"looks: expected one of {','.join(map(str, stats.SEQUENTIAL_STANDARD_ERRORS))}, got "
+                             f"{self.looks!r}")
+
+    @classmethod
+    def from_scale(cls, scale: str, **overrides) -> PushToGoalConfig:
+        """``SCALES[scale]`` named `scale`, with the fields in `overrides` that are not None replaced; an override
+        named as a field of the setup (``max_time``, ``surface``, ``testbed``, ``effects``, ...) replaces the setup's
+        (validated: ValueError naming the field)."""
+        if scale not in SCALES:
+            raise ValueError(f"scale: expected one of {','.join(SCALES)}, got {scale!r}")
+        changes = {key: value for key, value in overrides.items() if value is not None}
+        setup_fields = {field.name for field in dataclasses.fields(episode.EpisodeConfig)}
+        setup = {key: changes.pop(key) for key in list(changes) if key in setup_fields}
+        if setup:
+            changes["setup"] = dataclasses.replace(changes.get("setup", SCALES[scale].setup), **setup)
+        return dataclasses.replace(SCALES[scale], scale=scale, **changes)
+
+
+_SMOKE_CONTROLLER = mpc.ControllerConfig(horizon=8, gradient=gradient.GradientConfig(iterations=15), candidates=16)
+SCALES = {
+    "smoke": PushToGoalConfig(objects=("rect1",), goals_per_object=2, models=("lynch",), planners=("gradient",),
+                              seed=0, setup=episode.EpisodeConfig(max_time=30.0), controller=_SMOKE_CONTROLLER),
+    "cpu": PushToGoalConfig(objects=OBJECT_NAMES, goals_per_object=2, models=("lynch",),
+                            planners=("gradient", "sampling"), seed=0, setup=episode.EpisodeConfig(max_time=60.0),
+                            controller=mpc.ControllerConfig()),
+    "full": PushToGoalConfig(objects=OBJECT_NAMES, goals_per_object=10, models=("lynch",),
+                             planners=("gradient", "sampling"), seed=0, setup=episode.EpisodeConfig(max_time=60.0),
+                             controller=mpc.ControllerConfig()),
+}
+"""The experiment's scales, defined here and only here: objects, goals per object, planners, simulated seconds per
+episode (``setup.max_time``) and controller settings (smoke: a shorter horizon, fewer planner iterations and contact
+candidates, which compile and plan faster); plain Lynch with motion capture, seed 0."""
+
+
 def label(model: str, state: str, states: Sequence[str]) -> str:
     """The rows' name of `model` with the state source `state`: the model's name when `states` is motion capture alone
     (the default), else ``model (state)`` with spaces around a ``+``, e.g. ``lynch (mocap + perception)``."""
@@ -146,19 +252,18 @@ def _model_specs(models: Sequence[str], effect_params: str,
     return specs
 
 
-def _settings(seed: int, setup: episode.EpisodeConfig, effect_params: str, controller: mpc.ControllerConfig,
-              loop_spec: model_file.AugmentedModel | None, states: tuple[str, ...],
-              position: episode.PositionSource | None, position_settings: dict | None) -> dict:
+def _settings(config: PushToGoalConfig, loop_spec: model_file.AugmentedModel | None) -> dict:
     """The run's settings, which key its episodes (:func:`_fingerprint`)."""
-    settings = {"seed": seed, "loop": dataclasses.asdict(setup), "effect_params": effect_params,
-                "controller": repr(controller)}
+    settings = {"seed": config.seed, "loop": dataclasses.asdict(config.setup), "effect_params": config.effect_params,
+                "controller": repr(config.controller)}
     if loop_spec is not None:
         settings["loop_model"] = loop_spec.as_dict()
-    if states != ("mocap",):  # the default keeps the fingerprints of the runs before state sources
-        settings["states"] = list(states)
-    if any("perception" in state for state in states):
+    if config.states != ("mocap",):  # the default keeps the fingerprints of the runs before state sources
+        settings["states"] = list(config.states)
+    if any("perception" in state for state in config.states):
+        position = config.position
         settings["position"] = {"description": position.description, "std_m": list(position.std),
-                                "every_periods": position.every, **(position_settings or {})}
+                                "every_periods": position.every, **(config.position_settings or {})}
         if position.gate is not None:
             settings["position"]["gate"] = position.gate
     return settings
@@ -175,53 +280,24 @@ def _finished(log: Path, fingerprint: str) -> dict[tuple, dict]:
     return done
 
 
-def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, models: Sequence[str],
-        planners: Sequence[str], seed: int, setup: episode.EpisodeConfig, effect_params: str = "",
-        controller: mpc.ControllerConfig = mpc.ControllerConfig(), loop_model: str | Path | None = None,
-        states: Sequence[str] = ("mocap",), position: episode.PositionSource | None = None,
-        position_settings: dict | None = None, looks: int = 1) -> dict:
-    """Runs every model and planner on every goal (resuming from ``workdir/episodes.jsonl``); returns the
-    results of :func:`summarise`.
-
-    Args:
-      workdir: the work folder (created).
-      objects: object names.
-      goals_per_object: goals per object (:func:`pushjax.control.goals.draw_goals`).
-      models: model names (:func:`model_effects`).
-      planners: planner names (:data:`pushjax.control.mpc.PLANNERS`).
-      seed: seed of the goals, the testbed's draws and the controllers' keys.
-      setup: the :class:`~pushjax.studies.episode.EpisodeConfig` (testbed, world, surface, limits).
-      effect_params: the models' effect parameters (:func:`parse_effect_params`).
-      controller: the controller's settings (``planner`` replaced by each of `planners`).
-      loop_model: the pushing model file of the ``loop`` model (needed when `models` has it).
-      states: state sources from :data:`pushjax.studies.episode.STATE_SOURCES`, no repeats.
-      position: the position source of the states with ``perception`` (needed when `states` has one).
-      position_settings: what identifies `position` in the results' settings and the episodes' fingerprint (e.g. the
-        trained model, its dataset and the noise estimate; JSON-able).
-      looks: which look at the models' comparison this run is (:func:`pushjax.stats.decide`; not part of the
-        episodes' fingerprint, so a second look resumes the first's episodes).
+def run(config: PushToGoalConfig, workdir: str | Path) -> dict:
+    """Runs every model and planner of `config` on every goal (resuming from ``workdir/episodes.jsonl``); returns the
+    results of :func:`summarise`, the scale's name (when `config` has one) in their settings.
 
     Raises:
-      ValueError: ``loop`` among `models` without `loop_model`, an unknown or repeated state source, or one with
-        perception without `position`; ModelFileError (a ValueError): a bad model file; one line.
+      ModelFileError (a ValueError): the ``loop`` model's file cannot be read; one line.
     """
-    states = tuple(states)
-    if not states or len(set(states)) != len(states) or not set(states) <= set(episode.STATE_SOURCES):
-        raise ValueError(f"states: expected a non-empty list from {','.join(episode.STATE_SOURCES)}, no repeats, "
-                         f"got {','.join(states)}")
-    if any("perception" in state for state in states) and position is None:
-        raise ValueError("position: the state sources with perception need a position source")
-    specs = _model_specs(models, effect_params, loop_model)
-    tasks = goals.draw_goals(objects, goals_per_object, seed)
-    settings = _settings(seed, setup, effect_params, controller, specs.get(LOOP_MODEL), states, position,
-                         position_settings)
+    specs = _model_specs(config.models, config.effect_params, config.loop_model)
+    tasks = goals.draw_goals(config.objects, config.goals_per_object, config.seed)
+    settings = _settings(config, specs.get(LOOP_MODEL))
     fingerprint = _fingerprint(settings)
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     log = workdir / "episodes.jsonl"
     done = _finished(log, fingerprint)
     rows = []
-    jobs = [(name, state, planner, task) for name in models for state in states for planner in planners
+    states = config.states
+    jobs = [(name, state, planner, task) for name in config.models for state in states for planner in config.planners
             for task in tasks]
     with log.open("a") as out:
         for name, state, planner, task in tqdm.tqdm(jobs, desc="push_to_goal", unit="goal"):
@@ -232,16 +308,19 @@ def run(workdir: str | Path, objects: Sequence[str], goals_per_object: int, mode
             spec = specs[name]
             model = make_model(task.obj, mu=spec.mu, effects=spec.effects, params=spec.params)
             sensors = episode.Sensors(motion_capture="mocap" in state,
-                                      position=position if "perception" in state else None)
-            result = episode.run_episode(mpc, model, dataclasses.replace(controller, planner=planner), task,
-                                         seed=seed, setup=setup, sensors=sensors)
+                                      position=config.position if "perception" in state else None)
+            result = episode.run_episode(mpc, model, dataclasses.replace(config.controller, planner=planner), task,
+                                         seed=config.seed, setup=config.setup, sensors=sensors)
             row = {"fingerprint": fingerprint, "model": key[0], "planner": planner, "object": task.obj,
                    "index": task.index, **({} if states == ("mocap",) else {"model_name": name, "state": state}),
                    **episode_row(task, result, TRAJECTORY_STRIDE)}
             out.write(json.dumps(row) + "\n")
             out.flush()
             rows.append(row)
-    return summarise(rows, settings, looks)
+    results = summarise(rows, settings, config.looks)
+    if config.scale is not None:
+        results["settings"]["scale"] = config.scale
+    return results
 
 
 def episode_row(task: goals.Goal, result, stride: int) -> dict:

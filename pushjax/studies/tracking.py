@@ -27,43 +27,42 @@ it, beside ``ekf_prediction_only``, the EKF with nothing after the first sample 
 tracks, which the readings must beat to add anything); and the row ``perception``: the readings themselves against
 the true centre of mass (no yaw). Every EKF row runs
 one compiled program: the rows without readings pass an all-missing stream, which leaves them as they were.
+
+A run is a :class:`TrackingConfig` (its scales :data:`SCALES`, :meth:`TrackingConfig.from_scale`), validated when
+made; :func:`run` simulates its pushes and tracks them (:func:`track_pushes`), :func:`write` writes the report
+(:mod:`pushjax.studies.tracking_report`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Sequence
 from pathlib import Path
 
 import jax
-import matplotlib.pyplot as plt
 import numpy as np
 import tqdm
 
 from pushjax import outputs, planar, stats
 from pushjax.filter import constant_velocity, ekf, metrics, models, noise, particle, ukf
 from pushjax.filter.observations import PositionStream, TrackedPush
-from pushjax.geometry.objects import get_object
+from pushjax.geometry.objects import OBJECT_NAMES, get_object
+from pushjax.sensing import perception as sensing
 from pushjax.sim import dataset
-from pushjax.sim.testbed import Testbed
+from pushjax.sim.testbed import REALISTIC, Testbed
+from pushjax.studies import tracking_report
 
 __all__ = ["FILTERS", "PERCEPTION_FILTERS", "SCALES", "SEED_COMPARISONS", "TRAINING_SEED_OFFSET", "TUNING_SEED",
-           "batches_by_object", "compare_over_seeds", "hand_set_noise", "learn_noise", "run", "simulate_pushes",
-           "seeds_table", "write"]
+           "TrackingConfig", "batches_by_object", "compare_over_seeds", "hand_set_noise", "learn_noise", "run",
+           "simulate_pushes", "seeds_table", "track_pushes", "write"]
 
 FILTERS = ("ekf", "ukf", "particle", "ekf_learned")
 PERCEPTION_FILTERS = ("ekf_perception", "ekf_perception_only", "ekf_prediction_only")
 """The rows a :class:`~pushjax.filter.observations.PositionStream` adds: the EKF with motion capture and the readings, with the readings alone
 after the first motion-capture sample, and, their reference, with nothing after it (the process model alone)."""
 RECORDING_RATE_HZ = 250
-SCALES = {
-    "smoke": {"objects": ("rect1",), "pushes": 2, "particles": 64, "rate_hz": 5.0, "learn_steps": 3},
-    "cpu": {"objects": ("rect1", "tri2", "hex"), "pushes": 12, "particles": 256, "rate_hz": 10.0,
-            "learn_steps": 200},
-}
-"""Objects, pushes per object (abs, 20 mm/s), particles, filter rate and Adam steps of ``ekf_learned``'s noise
-(:func:`pushjax.filter.noise.learn`) of each scale."""
 TRAINING_SEED_OFFSET = 1
 """``ekf_learned`` learns its noise on pushes simulated with seed ``seed + TRAINING_SEED_OFFSET`` (other pushes,
 other draws of the testbed) and is evaluated, like every filter, on the pushes of ``seed``."""
@@ -84,6 +83,109 @@ LATENT_PRIOR_STD = (0.5, 0.3)
 noise (:func:`pushjax.filter.noise.initial_belief`)."""
 ACCELERATION_PSD = (1e-4, 1e-4, 1e-1)
 """Constant-velocity filter: white acceleration spectral densities ((m/s^2)^2 s, (m/s^2)^2 s, (rad/s^2)^2 s)."""
+
+
+def _whole(name: str, value, least: int, what: str = "a whole number") -> None:
+    if isinstance(value, bool) or not isinstance(value, int) or value < least:
+        raise ValueError(f"{name}: expected {what} >= {least}, got {value!r}")
+
+
+def _divides(rate_hz: float, divided_by) -> bool:
+    """Whether `divided_by` is a finite rate > 0 into which `rate_hz` divides a whole number of times."""
+    if not (isinstance(divided_by, (int, float)) and math.isfinite(divided_by) and 0 < divided_by <= rate_hz):
+        return False
+    step = rate_hz / divided_by
+    return abs(step - round(step)) < 1e-9
+
+
+@dataclasses.dataclass(frozen=True)
+class TrackingConfig:
+    """What a run of the study does (:func:`run`); the scales' are :data:`SCALES` (:meth:`from_scale`).
+
+    Attributes:
+      objects: the pushed objects, from ``OBJECT_NAMES``, no repeats.
+      pushes: pushes per object (abs, 20 mm/s; :func:`simulate_pushes`).
+      particles: the particle filter's particle count.
+      rate_hz: the filter rate, Hz: :data:`RECORDING_RATE_HZ` divided by a whole number.
+      learn_steps: Adam steps of ``ekf_learned``'s noise (:func:`learn_noise`).
+      filters: names from :data:`FILTERS`, no repeats.
+      seed: seed of the evaluated pushes, the testbed's draws and the particle filter; ``ekf_learned`` and the
+        perception's noise are learned on the pushes of ``seed + TRAINING_SEED_OFFSET``.
+      testbed: the testbed profile the pushes are simulated on; its tracking noise is the filters' hand-set
+        measurement noise.
+      perception: a trained model's perception (:class:`pushjax.sensing.perception.PerceptionSensor`) whose readings
+        are a second observation stream (the rows of :data:`PERCEPTION_FILTERS` and ``perception``), or None.
+      perception_hz: the rate of its readings, Hz: `rate_hz` divided by a whole number (used with `perception`).
+      scale: the name of the scale the config was made from (:meth:`from_scale`; recorded in the results), or None.
+
+    Raises:
+      ValueError: a field out of its range, naming it (``<field>: <what was expected>``); one line.
+    """
+
+    objects: tuple[str, ...]
+    pushes: int
+    particles: int
+    rate_hz: float
+    learn_steps: int
+    filters: tuple[str, ...] = FILTERS
+    seed: int = 0
+    testbed: Testbed = REALISTIC
+    perception: sensing.PerceptionSensor | None = None
+    perception_hz: float = 2.5
+    scale: str | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "objects", tuple(self.objects))
+        object.__setattr__(self, "filters", tuple(self.filters))
+        if not self.objects or len(set(self.objects)) != len(self.objects) or not set(self.objects) <= set(OBJECT_NAMES):
+            raise ValueError(f"objects: expected a non-empty list from {','.join(OBJECT_NAMES)}, no repeats, got "
+                             f"{','.join(self.objects) or 'none'}")
+        _whole("pushes", self.pushes, 1)
+        _whole("particles", self.particles, 1)
+        if not _divides(RECORDING_RATE_HZ, self.rate_hz):
+            raise ValueError(f"rate_hz: expected {RECORDING_RATE_HZ} Hz divided by a whole number, got {self.rate_hz!r}")
+        _whole("learn_steps", self.learn_steps, 1, "a whole number of steps")
+        if not self.filters or len(set(self.filters)) != len(self.filters) or not set(self.filters) <= set(FILTERS):
+            raise ValueError(f"filters: expected a non-empty list of known filters ({','.join(FILTERS)}), no repeats, "
+                             f"got {','.join(self.filters) or 'none'}")
+        _whole("seed", self.seed, 0)
+        if self.perception is not None and not _divides(self.rate_hz, self.perception_hz):
+            raise ValueError(f"perception_hz: expected the filter rate {self.rate_hz:g} Hz divided by a whole number, "
+                             f"got {self.perception_hz:g}")
+
+    @classmethod
+    def from_scale(cls, scale: str, **overrides) -> TrackingConfig:
+        """``SCALES[scale]`` named `scale`, with the fields in `overrides` that are not None replaced (validated:
+        ValueError naming the field)."""
+        if scale not in SCALES:
+            raise ValueError(f"scale: expected one of {','.join(SCALES)}, got {scale!r}")
+        changes = {key: value for key, value in overrides.items() if value is not None}
+        return dataclasses.replace(SCALES[scale], scale=scale, **changes)
+
+    @property
+    def learns(self) -> bool:
+        """Whether ``ekf_learned`` is among the filters."""
+        return "ekf_learned" in self.filters
+
+    @property
+    def training_seed(self) -> int:
+        """The seed of the pushes the noise is learned or estimated on."""
+        return self.seed + TRAINING_SEED_OFFSET
+
+    @property
+    def measurement_std(self) -> tuple[float, float, float]:
+        """The filters' hand-set measurement noise (x m, y m, yaw rad): the testbed's tracking noise."""
+        return (max(self.testbed.tracking_noise_xy, 1e-5), max(self.testbed.tracking_noise_xy, 1e-5),
+                max(self.testbed.tracking_noise_yaw, 1e-4))
+
+
+SCALES = {
+    "smoke": TrackingConfig(objects=("rect1",), pushes=2, particles=64, rate_hz=5.0, learn_steps=3),
+    "cpu": TrackingConfig(objects=("rect1", "tri2", "hex"), pushes=12, particles=256, rate_hz=10.0, learn_steps=200),
+}
+"""The study's scales, defined here and only here: objects, pushes per object (abs, 20 mm/s), particles, filter rate
+and Adam steps of ``ekf_learned``'s noise (:func:`pushjax.filter.noise.learn`); every filter, seed 0, the realistic
+testbed."""
 
 
 def _on_clock(stream: np.ndarray, indices: np.ndarray) -> np.ndarray:
@@ -281,9 +383,30 @@ def _summary(filters: Sequence[str], estimates: dict, truths: list, valid_masks:
     return summary
 
 
-def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, particles: int, seed: int,
-        measurement_std: Sequence[float], training_pushes: Sequence[TrackedPush] = (), learn_steps: int = 0,
-        perception: PositionStream | None = None) -> dict:
+def run(config: TrackingConfig, workdir: str | Path | None = None) -> dict:
+    """Simulates the pushes of `config` (and, for ``ekf_learned`` or the perception, as many of its training seed),
+    tracks them (:func:`track_pushes`); returns the results (see :func:`write`) with the config's ``scale``, ``seed``,
+    ``testbed`` and, when pushes of it were simulated, ``training_seed``. Nothing is written: the pushes stay in
+    memory (`workdir` is taken so that every study runs alike)."""
+    pushes = simulate_pushes(config.objects, config.pushes, config.seed, config.testbed, config.rate_hz)
+    uses_training = config.learns or config.perception is not None
+    training_pushes = (simulate_pushes(config.objects, config.pushes, config.training_seed, config.testbed,
+                                       config.rate_hz) if uses_training else [])
+    every = round(config.rate_hz / config.perception_hz) if config.perception is not None else 1
+    readings = (sensing.stream(config.perception, pushes, training_pushes, every, config.rate_hz,
+                               config.training_seed) if config.perception is not None else None)
+    results = track_pushes(pushes, config.filters, config.rate_hz, config.particles, config.seed,
+                           config.measurement_std, training_pushes if config.learns else (), config.learn_steps,
+                           readings)
+    results.update(scale=config.scale, seed=config.seed, testbed=config.testbed.to_dict())
+    if uses_training:
+        results.update(training_seed=config.training_seed)
+    return results
+
+
+def track_pushes(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, particles: int, seed: int,
+                 measurement_std: Sequence[float], training_pushes: Sequence[TrackedPush] = (), learn_steps: int = 0,
+                 perception: PositionStream | None = None) -> dict:
     """Runs the filters and the constant-velocity baseline on the pushes; returns the results (see :func:`write`).
 
     Args:
@@ -352,105 +475,10 @@ def run(pushes: list[TrackedPush], filters: Sequence[str], rate_hz: float, parti
     return results
 
 
-def _table(results: dict) -> str:
-    lines = [("| estimate | position RMSE (mm) | yaw RMSE (deg) | NEES in 95 % band | median NEES | mu: mean abs log "
-              "error, prior → final | mu: posterior std / prior std |"), "|---|---:|---:|---:|---:|---:|---:|"]
-    for name, entry in results["summary"].items():
-        band = f"{entry['nees_in_95_band']:.2f}" if "nees_in_95_band" in entry else ""
-        nees = f"{entry['nees_median']:.2f}" if "nees_median" in entry else ""
-        mu = (f"{entry['mu_prior_abs_log_error']:.2f} → {entry['mu_final_abs_log_error']:.2f}"
-              if "mu_final_abs_log_error" in entry else "")
-        spread = f"{entry['mu_final_std_log_over_prior']:.2f}" if "mu_final_std_log_over_prior" in entry else ""
-        yaw = f"{entry['yaw_rmse_deg']:.3f}" if "yaw_rmse_deg" in entry else "–"
-        lines.append(f"| {name} | {entry['position_rmse_mm']:.3f} | {yaw} | {band} | {nees} | {mu} | {spread} |")
-    lines += _noise_table(results)
-    lines += _perception_lines(results)
-    header = " | ".join(f"{f}: final mu ± std(log), within 20 % after" for f in results["filters"])
-    lines += ["", f"| push | mu true (nominal) | {header} |", "|---|---:|" + "---:|" * len(results["filters"])]
-    for row in results["pushes"]:
-        cells = []
-        for name in results["filters"]:
-            entry = row["filters"][name]
-            after = entry["mu_within_20_percent_after_s"]
-            cells.append(f"{entry['mu'][-1]:.3f} ± {entry['mu_std_log'][-1]:.2f}, "
-                         + ("never" if after is None else f"{after:.1f} s"))
-        lines.append(f"| {row['object']} {row['name'].split('_a=')[1].removesuffix('.h5')} | {row['mu_true']:.3f} "
-                     f"({row['mu_nominal']:.2f}) | " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
-
-
-_NOISE_ROWS = (
-    ("process x per sqrt(s) (mm)", "process_std", 0, 1e3, True),
-    ("process y per sqrt(s) (mm)", "process_std", 1, 1e3, True),
-    ("process yaw per sqrt(s) (deg)", "process_std", 2, math.degrees(1.0), True),
-    ("process log mu per sqrt(s)", "process_std", 3, 1.0, True),
-    ("process log l per sqrt(s)", "process_std", 4, 1.0, True),
-    ("measurement x (mm)", "measurement_std", 0, 1e3, False),
-    ("measurement y (mm)", "measurement_std", 1, 1e3, False),
-    ("measurement yaw (deg)", "measurement_std", 2, math.degrees(1.0), False),
-)
-"""The rows of the noise table: label, key of :func:`pushjax.filter.noise.standard_deviations`, index, unit factor,
-per step converted to per sqrt(s)."""
-
-
-def _noise_table(results: dict) -> list[str]:
-    """The hand-set noise standard deviations beside the learned ones (if any) and the learning's loss curve."""
-    columns = [name for name in ("hand_set", "learned") if name in results["noise"]]
-    lines = ["", "| noise (standard deviation) | " + " | ".join(name.replace("_", "-") for name in columns) + " |",
-             "|---|" + "---:|" * len(columns)]
-    for label, key, index, unit, per_step in _NOISE_ROWS:
-        factor = unit * (math.sqrt(results["rate_hz"]) if per_step else 1.0)
-        cells = [f"{factor * results['noise'][name][key][index]:.4g}" for name in columns]
-        lines.append(f"| {label} | " + " | ".join(cells) + " |")
-    if "noise_learning" in results:
-        learning = results["noise_learning"]
-        curve = learning["loss_curve"]
-        marks = sorted({round(fraction * (len(curve) - 1)) for fraction in (0, 0.25, 0.5, 0.75, 1)})
-        seed = f" (seed {results['training_seed']})" if "training_seed" in results else ""
-        lines += ["", f"ekf_learned: noise learned on {learning['training_pushes']} training pushes{seed} in "
-                  f"{learning['steps']} Adam steps ({learning['seconds_with_compile']:.0f} s with compilation), the "
-                  f"latents' prior kept ({', '.join(f'{v:g}' for v in results['prior_std'][3:])} for log mu, log l); "
-                  "loss (pose NLL, nats per step) at step " + ", ".join(f"{k}: {curve[k]:.4f}" for k in marks) + "."]
-    return lines
-
-
-def _perception_lines(results: dict) -> list[str]:
-    """What the perception rows rest on: the model, its rate and its noise (and where that was estimated)."""
-    if "perception" not in results:
-        return []
-    info = results["perception"]
-    std = ", ".join(f"{1e3 * value:.2f}" for value in info["std"])
-    return ["", f"perception: {info['model']} at {info['rate_hz']:g} Hz; the position row `perception` is its readings "
-            f"of the centre of mass against the truth (no yaw); reading noise (x, y) {std} mm, "
-            f"{info['noise_estimated_on']}."
-            + (f" {info['scenes']} scenes rendered and located in {info['seconds_with_compile']:.1f} s with compilation."
-               if "scenes" in info else "")]
-
-
-def _figure(results: dict, path: Path, pushes: int = 4) -> None:
-    name = results["filters"][0]
-    rows = results["pushes"][:pushes]
-    figure, axes = plt.subplots(1, len(rows), figsize=(3.2 * len(rows), 2.8), squeeze=False)
-    for axis, row in zip(axes[0], rows):
-        mu = np.asarray(row["filters"][name]["mu"])
-        spread = np.asarray(row["filters"][name]["mu_std_log"])
-        seconds = np.arange(len(mu)) / results["rate_hz"]
-        axis.fill_between(seconds, mu * np.exp(-2 * spread), mu * np.exp(2 * spread), alpha=0.3, label="± 2 std")
-        axis.plot(seconds, mu, label=f"{name} estimate")
-        axis.axhline(row["mu_true"], color="k", linestyle="--", label="true")
-        axis.set_yscale("log")
-        axis.set_xlabel("time (s)")
-        axis.set_title(f"{row['object']} {row['name'].split('_s=')[1].removesuffix('.h5')}", fontsize=8)
-    axes[0][0].set_ylabel("pusher friction mu")
-    axes[0][0].legend(fontsize=7)
-    figure.tight_layout()
-    figure.savefig(path, dpi=100)
-    plt.close(figure)
-
-
 def write(results: dict, workdir: str | Path) -> list[Path]:
     """Writes ``results.json``, ``results.md`` (the tables) and ``mu_over_time.png`` to `workdir`."""
-    return outputs.write_results(workdir, results, _table(results), "mu_over_time.png", _figure)
+    return outputs.write_results(workdir, results, tracking_report.table(results), "mu_over_time.png",
+                                 tracking_report.figure)
 
 
 def compare_over_seeds(records: Sequence[dict]) -> dict:

@@ -9,7 +9,7 @@ import pytest
 from pushjax.control import cost, model, mpc
 from pushjax.studies import push_to_goal
 
-CONFIG = push_to_goal.SCALES["smoke"]["controller"]
+CONFIG = push_to_goal.SCALES["smoke"].controller
 
 
 @pytest.mark.parametrize("changes, message", [

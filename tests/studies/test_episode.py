@@ -18,7 +18,7 @@ from pushjax.sensing import perception
 from pushjax.sim.testbed import REALISTIC
 from pushjax.studies import episode, push_to_goal
 
-CONFIG = push_to_goal.SCALES["smoke"]["controller"]
+CONFIG = push_to_goal.SCALES["smoke"].controller
 """The smoke run's controller (a short horizon: its programs compile faster, once for both)."""
 
 

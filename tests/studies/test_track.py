@@ -1,14 +1,17 @@
 """``python -m experiments.track --scale=smoke``: simulated testbed pushes tracked end to end, with a trained hybrid
 model's perception (the committed ``results/track_perception/model``) as a second observation stream."""
 
+import dataclasses
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from pushjax.studies import tracking
 from pushjax.sim.testbed import REALISTIC
@@ -52,7 +55,7 @@ def test_smoke_run_writes_the_tables_and_the_figure(tmp_path):
     assert "| ekf_learned |" in (tmp_path / "results.md").read_text()
     assert results["training_seed"] == results["seed"] + tracking.TRAINING_SEED_OFFSET
     learning = results["noise_learning"]
-    assert learning["steps"] == tracking.SCALES["smoke"]["learn_steps"]
+    assert learning["steps"] == tracking.SCALES["smoke"].learn_steps and results["scale"] == "smoke"
     curve = learning["loss_curve"]
     assert len(curve) == learning["steps"] + 1 and curve[-1] < curve[0]
     hand_set, learned = results["noise"]["hand_set"], results["noise"]["learned"]
@@ -61,7 +64,7 @@ def test_smoke_run_writes_the_tables_and_the_figure(tmp_path):
         assert all(value > 0 for value in learned[key])
     np.testing.assert_allclose(hand_set["measurement_std"], results["measurement_std"])
     pushes = results["pushes"]
-    assert len(pushes) == tracking.SCALES["smoke"]["pushes"]
+    assert len(pushes) == tracking.SCALES["smoke"].pushes
     assert sum(push["dropped"] for push in pushes) > 0  # 20 % of the samples dropped: skipped, not zeros
     for push in pushes:
         for name in (*tracking.FILTERS, *tracking.PERCEPTION_FILTERS):
@@ -79,6 +82,36 @@ def test_simulated_pushes_keep_their_truth_and_their_gaps():
     assert np.abs(error).max() < 6 * REALISTIC.tracking_noise_xy
     assert push.mu_true != push.mu_nominal > 0
     assert len(push.pusher) == len(push.truth) > 50  # 25 Hz over a push of a few seconds
+
+
+@pytest.mark.parametrize("field, value", [
+    ("objects", ()), ("objects", ("box",)), ("objects", ("rect1", "rect1")), ("pushes", 0), ("particles", 0),
+    ("particles", 2.0), ("rate_hz", 0.0), ("rate_hz", 7.0), ("rate_hz", math.nan), ("rate_hz", 500.0),
+    ("learn_steps", 0), ("learn_steps", -3), ("filters", ()), ("filters", ("kalman",)), ("filters", ("ekf", "ekf")),
+    ("seed", -1), ("seed", 1.5)])
+def test_a_bad_field_is_a_value_error_naming_it(field, value):
+    with pytest.raises(ValueError, match=rf"^{re.escape(field)}: "):
+        tracking.TrackingConfig.from_scale("smoke", **{field: value})
+
+
+def test_scales_are_configs_with_their_overrides():
+    smoke = tracking.TrackingConfig.from_scale("smoke")
+    assert smoke == dataclasses.replace(tracking.SCALES["smoke"], scale="smoke")
+    assert (smoke.objects, smoke.pushes, smoke.particles, smoke.rate_hz, smoke.learn_steps) == (
+        ("rect1",), 2, 64, 5.0, 3)
+    assert smoke.filters == tracking.FILTERS and smoke.seed == 0 and smoke.testbed == REALISTIC
+    changed = tracking.TrackingConfig.from_scale("cpu", filters=["ekf"], rate_hz=None, seed=3)
+    assert changed.filters == ("ekf",) and changed.rate_hz == tracking.SCALES["cpu"].rate_hz and changed.seed == 3
+    assert (changed.learns, changed.training_seed) == (False, 3 + tracking.TRAINING_SEED_OFFSET)
+    assert changed.measurement_std == (REALISTIC.tracking_noise_xy, REALISTIC.tracking_noise_xy,
+                                       REALISTIC.tracking_noise_yaw)
+    with pytest.raises(ValueError, match="^scale: "):
+        tracking.TrackingConfig.from_scale("huge")
+    # The perception's rate must divide the filter rate, checked only with a perception (a stand-in sensor here).
+    assert tracking.TrackingConfig.from_scale("smoke", perception_hz=3.0).perception_hz == 3.0
+    with pytest.raises(ValueError, match="^perception_hz: expected the filter rate 5 Hz divided by a whole number"):
+        tracking.TrackingConfig.from_scale("smoke", perception_hz=3.0, perception=object())
+    assert tracking.TrackingConfig.from_scale("smoke", perception_hz=2.5, perception=object()).perception_hz == 2.5
 
 
 def _record(seed: int, ekf_errors, raw_errors) -> dict:
