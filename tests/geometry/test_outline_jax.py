@@ -95,17 +95,23 @@ def test_vertex_normal_turns_with_the_pusher():
     assert np.allclose(normals[0], [0, 1]) and not np.allclose(normals[-1], [0, 1])
 
 
+def _contact_vector(shape, pusher, offset, motion):
+    hit = outline_jax.first_contact(shape, pusher - offset, motion)
+    return jnp.concatenate([hit.point, hit.normal, hit.fraction[None], hit.gap[None]])
+
+
+_second_derivative = jax.jit(jax.grad(
+    lambda offset, shape, pusher, motion: jnp.sum(jax.jacfwd(_contact_vector, argnums=2)(shape, pusher, offset,
+                                                                                      motion))))
+"""d/d offset of the sum of d contact / d offset (one program for every case below, not op by op)."""
+
+
 @pytest.mark.parametrize("length", [1e-25, 1e-20, 1e-16])
 def test_second_derivatives_are_finite_for_a_pusher_standing_still_up_to_float_noise(length):
     """A touching pusher that moves by float noise (as the testbed's pusher after its push): the derivative of the
     contact's Jacobian (what learning a filter's noise differentiates) is finite, as for a pusher exactly still."""
     shape = outline_jax.outline("rect1")
     pusher = jnp.array([float(get_object("rect1").outline[:, 0].min()) - PUSHER_RADIUS, 0.0], jnp.float32)
-
-    def contact(offset, motion):
-        hit = outline_jax.first_contact(shape, pusher - offset, motion)
-        return jnp.concatenate([hit.point, hit.normal, hit.fraction[None], hit.gap[None]])
-
     for motion in (jnp.array([length, 0.0], jnp.float32), jnp.zeros(2, jnp.float32)):
-        second = jax.grad(lambda offset: jnp.sum(jax.jacfwd(contact)(offset, motion)))(jnp.zeros(2, jnp.float32))
+        second = _second_derivative(jnp.zeros(2, jnp.float32), shape, pusher, motion)
         assert np.all(np.isfinite(np.asarray(second))), (length, second)

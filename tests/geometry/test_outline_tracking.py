@@ -127,6 +127,18 @@ def test_local_search_rolls_out_as_the_full_search(name):
         assert needs.mean() < 0.2  # (the fallback: test_local_first_contact_is_the_full_one_from_any_feature)
 
 
+_initial_features = jax.jit(jax.vmap(outline_jax.initial_feature, in_axes=(None, 0)))
+_one_contact = jax.jit(outline_jax.first_contact, static_argnames="search")
+_windows = jax.jit(jax.vmap(outline_jax._local, in_axes=(None, 0, 0, None, 0)))
+
+
+@functools.cache
+def _contacts(search):
+    """The first contacts of a batch of pushes, each searched from its own feature (every object: one program)."""
+    contact = functools.partial(outline_jax.first_contact, search=search)
+    return jax.jit(jax.vmap(lambda *args: contact(*args), in_axes=(None, 0, 0, None, 0)))
+
+
 @pytest.mark.parametrize("name", ["ellip1", "ellip3", "butter"])
 def test_local_first_contact_is_the_full_one_from_any_feature(name):
     """Pushes from anywhere around the object, starting the search at any edge: the window's choice where it can
@@ -142,18 +154,12 @@ def test_local_first_contact_is_the_full_one_from_any_feature(name):
     with jax.enable_x64(True):
         shape = outline_jax.outline(obj, jnp.float64)
         exact = int(shape.count)
-        near = np.asarray(jax.vmap(outline_jax.initial_feature, in_axes=(None, 0))(shape, start))
+        near = np.asarray(_initial_features(shape, start))
         features = np.where(rng.uniform(size=count) < 0.5, near, rng.integers(0, exact, count))
-
-        def batched(search):
-            contact = functools.partial(outline_jax.first_contact, search=search)
-            return jax.jit(jax.vmap(lambda *args: contact(*args), in_axes=(None, 0, 0, None, 0)))(
-                shape, start, motion, PUSHER_RADIUS, features)
-
-        got, expected = batched("local"), batched("full")
-        one = outline_jax.first_contact(shape, start[3], motion[3], feature=features[3])
-        _, needs = jax.vmap(outline_jax._local, in_axes=(None, 0, 0, None, 0))(shape, start, motion, PUSHER_RADIUS,
-                                                                                features)
+        got, expected = (_contacts(search)(shape, start, motion, PUSHER_RADIUS, features)
+                         for search in ("local", "full"))
+        one = _one_contact(shape, start[3], motion[3], feature=features[3])
+        _, needs = _windows(shape, start, motion, PUSHER_RADIUS, features)
     for field in outline_jax.Contact._fields[:-1]:
         np.testing.assert_allclose(np.asarray(getattr(got, field)), np.asarray(getattr(expected, field)), rtol=0,
                                    atol=1e-12, err_msg=field)
@@ -200,9 +206,9 @@ def test_padding_never_wins_and_changes_nothing():
         hit = outline_jax.first_contact(shape, pusher, motion, search=search)
         return jnp.sum(hit.point) + jnp.sum(hit.normal) + hit.fraction + hit.gap, hit
 
+    run = jax.jit(jax.vmap(jax.value_and_grad(total, argnums=(1, 2), has_aux=True), in_axes=(None, 0, 0, None)),
+                  static_argnums=3)
     for search in ["local", "full"]:
-        run = jax.jit(jax.vmap(jax.value_and_grad(total, argnums=(1, 2), has_aux=True), in_axes=(None, 0, 0, None)),
-                      static_argnums=3)
         (_, got), got_grads = run(padded, pushers, motions, search)
         (_, expected), expected_grads = run(plain, pushers, motions, "full")
         for field in outline_jax.Contact._fields[:-1]:

@@ -75,22 +75,27 @@ def test_generalised_solver_is_lynch_for_isotropic_friction_in_float64():
     np.testing.assert_allclose(predicted, expected, rtol=0, atol=1e-13 * np.abs(expected).max())
 
 
+_ELLIPSOID_MODEL = effects.compose(effects.ELLIPSOID_EFFECTS)
+_SQUARED_ERROR_GRADIENT = jax.jit(jax.grad(
+    lambda params, inputs, target: jnp.sum((_ELLIPSOID_MODEL(params, inputs) - target) ** 2), argnums=(0, 1)))
+"""d/d(params, inputs) of sum |model(params, inputs) - target|^2 for every ellipsoid effect at once: one program for
+the two tests below (2000 pushes each), not their gradients eagerly, op by op."""
+
+
 def test_gradients_are_finite_at_no_effect_and_degenerate_inputs():
-    inputs = _random_inputs(2, count=64)
+    inputs = _random_inputs(2, count=2000)
     zero = jnp.zeros_like(inputs.normal)
     degenerate = [inputs, inputs.replace(normal=zero), inputs.replace(action=zero, pusher_motion=zero),
                   inputs.replace(s=jnp.zeros_like(inputs.s)), inputs.replace(contact=zero)]
-    model = effects.compose(effects.ELLIPSOID_EFFECTS)
     for case, params in itertools.product(degenerate, (effects.init_params(), _random_params(3))):
-        gradient = jax.grad(lambda p, i: jnp.sum(model(p, i) ** 2), argnums=(0, 1))(params, case)
+        gradient = _SQUARED_ERROR_GRADIENT(params, case, jnp.zeros((len(case.mu), 3)))
         assert all(np.all(np.isfinite(leaf)) for leaf in jax.tree.leaves(gradient))
 
 
 def test_gradient_at_no_effect_points_somewhere_for_every_effect():
     inputs = _random_inputs(4, count=2000)
-    target = effects.compose(effects.ELLIPSOID_EFFECTS)(_random_params(5), inputs)
-    model = effects.compose(effects.ELLIPSOID_EFFECTS)
-    gradient = jax.grad(lambda p: jnp.sum((model(p, inputs) - target) ** 2))(effects.init_params())
+    target = jax.jit(_ELLIPSOID_MODEL)(_random_params(5), inputs)
+    gradient, _ = _SQUARED_ERROR_GRADIENT(effects.init_params(), inputs, target)
     for name in effects.ELLIPSOID_EFFECTS:
         assert any(np.any(np.asarray(leaf) != 0) for leaf in jax.tree.leaves(gradient[name])), name
 
@@ -112,8 +117,9 @@ def test_vmaps_over_parameter_sets():
     model = effects.compose(effects.ELLIPSOID_EFFECTS)
     stacked = jax.tree.map(lambda *leaves: jnp.stack(leaves), *(_random_params(seed) for seed in range(3)))
     batched = jax.jit(jax.vmap(model, in_axes=(0, None)))(stacked, inputs)
+    one = jax.jit(model)  # one program for the three parameter sets, not each op by op
     for k in range(3):
-        np.testing.assert_allclose(batched[k], model(_random_params(k), inputs), rtol=1e-5, atol=1e-7)
+        np.testing.assert_allclose(batched[k], one(_random_params(k), inputs), rtol=1e-5, atol=1e-7)
 
 
 def test_friction_ratio_and_pusher_friction_scale_l_and_mu():
@@ -419,7 +425,7 @@ def test_limit_surface_is_differentiable_and_refuses_what_it_cannot_compose():
     # (A random frame offset moves these pushes' contacts off the square's side: no motion to differentiate.)
     params["frame_offset"] = {"offset": jnp.zeros(2)}
     params["limit_surface"] = {"rim": jnp.asarray(0.3), "feet": jnp.asarray(0.0)}
-    gradient = jax.grad(lambda p: jnp.sum(model(p, inputs) ** 2))(params)
+    gradient = jax.jit(jax.grad(lambda p: jnp.sum(model(p, inputs) ** 2)))(params)  # one program, not op by op
     assert all(np.all(np.isfinite(leaf)) for leaf in jax.tree.leaves(gradient))
     assert np.asarray(gradient["limit_surface"]["rim"]) != 0 and np.all(np.asarray(gradient["cof_offset"]["offset"]) != 0)
     assert set(effects.EFFECT_NAMES) - set(names) == {"friction_ratio", "pressure_gradient", "anisotropic_friction"}

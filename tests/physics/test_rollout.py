@@ -291,7 +291,7 @@ def test_the_exact_limit_surface_needs_the_support_and_its_gradients_match_finit
         return rollout.rollout(shape, jnp.zeros(3), path, 0.04, mu, params, effects=("limit_surface",),
                                support=support_).poses[-1, 2]
 
-    gradient = jax.grad(final_yaw, argnums=(0, 1))(jnp.float32(0.15), jnp.float32(0.5))
+    gradient = jax.jit(jax.grad(final_yaw, argnums=(0, 1)))(jnp.float32(0.15), jnp.float32(0.5))
     for k, delta in enumerate(np.eye(2) * 2e-3):
         args = np.array([0.15, 0.5])
         difference = (final_yaw(*map(jnp.float32, args + delta)) - final_yaw(*map(jnp.float32, args - delta))) / 4e-3

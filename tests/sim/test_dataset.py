@@ -265,24 +265,29 @@ def test_cli_records_and_resumes(tmp_path):
 CLI_FLAGS = ["--objects=rect1", "--surfaces=abs", "--velocities=20", "--pushes=4", "--seed=6", "--workers=1"]
 
 
-def test_cli_runs_at_once_in_one_folder_give_the_files_of_one_run(tmp_path):
-    alone = run_cli(f"--out_dir={tmp_path / 'alone'}", *CLI_FLAGS)
-    assert alone.returncode == 0, alone.stderr
+@pytest.fixture(scope="module")
+def alone(tmp_path_factory) -> Path:
+    """The folder of one uninterrupted CLI run with `CLI_FLAGS`, which the two tests below compare theirs with."""
+    folder = tmp_path_factory.mktemp("alone")
+    result = run_cli(f"--out_dir={folder}", *CLI_FLAGS)
+    assert result.returncode == 0, result.stderr
+    return folder
+
+
+def test_cli_runs_at_once_in_one_folder_give_the_files_of_one_run(tmp_path, alone):
     command = [sys.executable, "-m", "experiments.record_pushes", f"--out_dir={tmp_path / 'shared'}", *CLI_FLAGS]
     runs = [subprocess.Popen(command, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
             for _ in range(2)]
     for run in runs:
         _, stderr = run.communicate(timeout=120)
         assert run.returncode == 0, stderr
-    assert files(tmp_path / "shared") == files(tmp_path / "alone")
+    assert files(tmp_path / "shared") == files(alone)
     manifest = dataset.MANIFEST_NAME
-    assert (tmp_path / "shared" / manifest).read_bytes() == (tmp_path / "alone" / manifest).read_bytes()
+    assert (tmp_path / "shared" / manifest).read_bytes() == (alone / manifest).read_bytes()
     assert not [path for path in (tmp_path / "shared").rglob("*") if path.name.endswith(".partial")]
 
 
-def test_cli_killed_and_resumed_gives_the_files_of_one_run(tmp_path):
-    alone = run_cli(f"--out_dir={tmp_path / 'alone'}", *CLI_FLAGS)
-    assert alone.returncode == 0, alone.stderr
+def test_cli_killed_and_resumed_gives_the_files_of_one_run(tmp_path, alone):
     flags = [f"--out_dir={tmp_path / 'killed'}", *CLI_FLAGS]
     run = subprocess.Popen([sys.executable, "-m", "experiments.record_pushes", *flags], cwd=REPO,
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -296,7 +301,7 @@ def test_cli_killed_and_resumed_gives_the_files_of_one_run(tmp_path):
     resumed = run_cli(*flags)
     assert resumed.returncode == 0, resumed.stderr
     assert f"reused {written_before_kill} valid existing files" in resumed.stdout
-    assert files(tmp_path / "killed") == files(tmp_path / "alone")
+    assert files(tmp_path / "killed") == files(alone)
 
 
 def test_cli_records_a_realistic_testbed_with_overrides(tmp_path):
