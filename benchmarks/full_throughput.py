@@ -1,7 +1,7 @@
 """Training throughput of the ``data_efficiency_full`` run (issue 30): model-steps per second per variant.
 
 One model of each variant of the run (and neural / hybrid at the paper's widths) with the ``cpu_full`` training config
-(64 x 64 depth, 20 x 20 px glimpses, batch 32, the single-model step `pushjax.train.convergence` jits) on the examples
+(64 x 64 depth, 20 x 20 px glimpses, batch 32, the single-model step the trainer jits in ``sequential`` mode) on the examples
 of ``--data_dir``'s ``data_efficiency`` dataset at ``--scale`` (the smoke dataset has the same image and glimpse
 size as ``cpu_full``). Per variant: the steady-state seconds per step (after `--warmup` steps), split into the input
 handling (drawing the batch's indices and gathering its arrays, `pushjax.train.batching`) and the jitted step; and
@@ -21,7 +21,6 @@ import time
 
 import jax
 import numpy as np
-import optax
 from absl import app, flags
 
 from pushjax import train
@@ -61,7 +60,7 @@ def main(argv):
         examples = train.examples_from_source(splits["train"], (*fields, *train.EVALUATION_FIELDS))
         spec = ModelSpec("bench", np.arange(len(examples["motion"])), seed=0)
         model = PushModel(config.model)
-        optimizer = optax.inject_hyperparams(optax.adam)(learning_rate=1e-3)
+        optimizer = train.make_optimizer(1e-3, adjustable=True)
         state = create_train_state(model, optimizer, gather(examples, batch_indices(spec, 0, 32), fields), 0)
         step_fn = jax.jit(make_train_step(model, optimizer, config.weight_decay))
         for step in range(_WARMUP.value):
@@ -98,7 +97,7 @@ def _time_models_at_once(splits, base, count: int) -> None:
         fields = model_fields(config.model)
         examples = train.examples_from_source(splits["train"], fields)
         model = PushModel(config.model)
-        optimizer = optax.inject_hyperparams(optax.adam)(learning_rate=1e-3)
+        optimizer = train.make_optimizer(1e-3, adjustable=True)
         step_fn = jax.jit(make_train_step(model, optimizer, config.weight_decay))
 
         def train_model(seed, steps, out):

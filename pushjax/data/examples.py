@@ -242,20 +242,12 @@ def sequence_examples(push: Push, config: DatasetConfig, renderer: DepthRenderer
     camera = renderer.camera
     frequency = 1.0 / float(push.time[1] - push.time[0])
     horizon_samples = round(config.horizon * frequency)
-    if config.experiment == "repeated":
-        starts = np.full(config.windows_per_sequence, round(config.repeated_start_time * frequency))
-        if starts[0] + horizon_samples >= len(push.time):
-            raise ValueError(f"config: repeated_start_time {config.repeated_start_time} s leaves no window")
-    else:
-        starts = _choose_windows(push, obj, horizon_samples, config, rng)
-    starts = np.repeat(starts, config.transforms_per_window)
+    starts = _window_starts(push, obj, frequency, horizon_samples, config, rng)
     count = len(starts)
 
-    pose0 = push.object[starts]
-    pose1 = push.object[starts + horizon_samples]
+    pose0, pose1 = push.object[starts], push.object[starts + horizon_samples]
     pusher = push.tip[starts, :2]
     action = push.tip[starts + horizon_samples, :2] - pusher
-
     rotation, translation = _scene_transforms(_com(obj, pose0), np.stack([pusher, pusher + action], axis=1),
                                               config, camera, rng)
 
@@ -266,16 +258,7 @@ def sequence_examples(push: Push, config: DatasetConfig, renderer: DepthRenderer
     pose0, pose1 = moved_scene(pose0), moved_scene(pose1)
     pusher = planar.rotate(pusher, rotation) + translation
     action = planar.rotate(action, rotation)
-
-    # Windows in which the pusher naturally misses the object count towards the no-contact share.
-    contact = annotate(obj, pose0, pusher, action)
-    missing = round(count * config.no_contact_fraction) - int(np.sum(~contact.touches))
-    moved = np.zeros(count, bool)
-    if missing > 0:
-        moved[rng.permutation(np.flatnonzero(contact.touches))[:missing]] = True
-        pusher[moved] = _moved_pushers(obj, pose0[moved], action[moved], camera, rng)
-        contact = annotate(obj, pose0, pusher, action)
-
+    contact, moved = _contact_with_misses(obj, pose0, pusher, action, config, camera, rng)
     com0, com1 = _com(obj, pose0), _com(obj, pose1)
     motion = np.concatenate([com1 - com0, (pose1[:, 2] - pose0[:, 2])[:, None]], axis=1)
     motion[moved] = 0.0
@@ -293,16 +276,8 @@ def sequence_examples(push: Push, config: DatasetConfig, renderer: DepthRenderer
     else:
         point_cloud = np.zeros(depth.shape + (3,), np.float32)
 
-    transform = np.zeros((count, 3, 3))
-    transform[:, :2, :2] = np.stack([np.stack([np.cos(rotation), -np.sin(rotation)], -1),
-                                     np.stack([np.sin(rotation), np.cos(rotation)], -1)], axis=1)
-    transform[:, :2, 2] = translation
-    transform[:, 2, 2] = 1.0
-
-    def repeated(value):
-        return np.broadcast_to(np.asarray(value), (count,) + np.shape(value))
-
     examples = {
+        **_sequence_fields(params, camera, l, mu, sequence_id, count),
         "depth": depth[..., None],
         "point_cloud": point_cloud,
         "pusher_pos": pusher,
@@ -316,24 +291,67 @@ def sequence_examples(push: Push, config: DatasetConfig, renderer: DepthRenderer
         "normal": contact.normal,
         "contact_flag": contact.touches,
         "action_from_contact": contact.action_from_contact,
-        "l": repeated(l),
-        "mu": repeated(mu),
         "push_velocity": np.asarray(push_velocity),
-        "object_id": repeated(OBJECT_NAMES.index(obj)),
-        "surface_id": repeated(_surface_id(params.surface)),
-        "velocity": repeated(params.velocity),
-        "push_angle": repeated(params.angle),
-        "contact_point_id": repeated(contact_point_id(params)),
-        "sequence_id": repeated(sequence_id),
         "start_time": push.time[starts],
-        "camera_intrinsics": repeated(np.array([camera.fx, camera.fy, camera.cx, camera.cy])),
-        "camera_extrinsics": repeated(np.asarray(camera.world_from_camera)),
-        "scene_transform": transform,
+        "scene_transform": _transform_matrices(rotation, translation),
         "object_pose": pose0,
         "pusher_moved": moved,
         "first_contact_fraction": contact.first_contact_fraction,
     }
     return {name: np.ascontiguousarray(examples[name], dtype=field.dtype) for name, field in ALL_FIELDS.items()}
+
+
+def _sequence_fields(params, camera, l: float, mu: float, sequence_id: int, count: int) -> dict[str, np.ndarray]:
+    """The fields every example of a sequence shares (its push's parameters `params`, the `camera`, the limit-surface
+    ratio `l` m, the pusher friction `mu`), each repeated `count` times."""
+
+    def repeated(value):
+        return np.broadcast_to(np.asarray(value), (count,) + np.shape(value))
+
+    return {"l": repeated(l), "mu": repeated(mu), "object_id": repeated(OBJECT_NAMES.index(params.shape)),
+            "surface_id": repeated(_surface_id(params.surface)), "velocity": repeated(params.velocity),
+            "push_angle": repeated(params.angle), "contact_point_id": repeated(contact_point_id(params)),
+            "sequence_id": repeated(sequence_id),
+            "camera_intrinsics": repeated(np.array([camera.fx, camera.fy, camera.cx, camera.cy])),
+            "camera_extrinsics": repeated(np.asarray(camera.world_from_camera))}
+
+
+def _window_starts(push: Push, obj: str, frequency: float, horizon_samples: int, config: DatasetConfig,
+                   rng: np.random.Generator) -> np.ndarray:
+    """[E] the first sample of each example's window (`frequency` Hz, windows of `horizon_samples`): chosen windows
+    (the ``repeated`` experiment: its one start), each `config.transforms_per_window` times."""
+    if config.experiment == "repeated":
+        starts = np.full(config.windows_per_sequence, round(config.repeated_start_time * frequency))
+        if starts[0] + horizon_samples >= len(push.time):
+            raise ValueError(f"config: repeated_start_time {config.repeated_start_time} s leaves no window")
+    else:
+        starts = _choose_windows(push, obj, horizon_samples, config, rng)
+    return np.repeat(starts, config.transforms_per_window)
+
+
+def _contact_with_misses(obj: str, pose0: np.ndarray, pusher: np.ndarray, action: np.ndarray, config: DatasetConfig,
+                         camera, rng: np.random.Generator):
+    """The windows' contact annotation after moving enough pushers off the object for `config.no_contact_fraction`
+    (windows in which the pusher naturally misses count towards it); `pusher` [E, 2] is moved in place. Returns the
+    annotation and the [E] bool mask of moved pushers."""
+    contact = annotate(obj, pose0, pusher, action)
+    missing = round(len(pusher) * config.no_contact_fraction) - int(np.sum(~contact.touches))
+    moved = np.zeros(len(pusher), bool)
+    if missing > 0:
+        moved[rng.permutation(np.flatnonzero(contact.touches))[:missing]] = True
+        pusher[moved] = _moved_pushers(obj, pose0[moved], action[moved], camera, rng)
+        contact = annotate(obj, pose0, pusher, action)
+    return contact, moved
+
+
+def _transform_matrices(rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
+    """[E, 3, 3] homogeneous planar transforms of the scene: rotation [E] rad, then translation [E, 2] m."""
+    transform = np.zeros((len(rotation), 3, 3))
+    transform[:, :2, :2] = np.stack([np.stack([np.cos(rotation), -np.sin(rotation)], -1),
+                                     np.stack([np.sin(rotation), np.cos(rotation)], -1)], axis=1)
+    transform[:, :2, 2] = translation
+    transform[:, 2, 2] = 1.0
+    return transform
 
 
 def _surface_id(surface: str) -> int:

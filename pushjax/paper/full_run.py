@@ -7,7 +7,8 @@ training subset per seed; at the full split every seed trains on the same exampl
 batch order), and `WIDE_VARIANTS` once at the paper's widths at the full split. At ``paper_full`` scale the same
 pushes, subsets and test sequences are rendered at the paper's images and every model has the paper's widths (a GPU's
 run). Each model trains by the convergence criterion of `pushjax.train.convergence` (constant rate until its validation
-score stops improving, within a budget growing with the size, then a short decay).
+score stops improving, within a budget growing with the size, then a short decay), a stopping rule of the one trainer
+(`pushjax.train.sweep`), or by the paper's fixed budget.
 
 A unit of work is one model; `run` reads the training rows the models it may train use (`read_training_examples`: the
 whole split once one trains on it) and trains them in order, one or a few at once (threads sharing those rows; a
@@ -17,7 +18,8 @@ to ``<workdir>/models/<key>.json`` (a few tens of KiB), and ``results.json``, ``
 assembled again from every record present. A later run with the same work directory skips every model that has a
 record, so the run resumes across sittings and fresh checkouts as long as the records are kept (committed); a
 model interrupted before its record is written continues from its training state, saved every 1 000 steps to
-``<workdir>/in_training/<key>/`` (`pushjax.train.convergence`; removed once the record is written), to the same
+``<workdir>/in_training/<key>/`` (the trainer's work directory of that model: ``checkpoints/``, ``metrics.csv``;
+removed once the record is written, kept under a fixed budget to be continued further), to the same
 parameters and record as without the interruption. Commit that folder with the records when a sitting ends (a few
 hundred KiB per model, a few MiB for the wide ones) and a fresh checkout continues those models too. The dataset is rebuilt from its
 seed when missing. Each trained model's parameters go to ``<workdir>/checkpoints/<key>/`` (not committed), from which
@@ -41,7 +43,7 @@ import numpy as np
 from pushjax import outputs, provenance as provenance_lib, train as train_lib
 from pushjax.models import ModelConfig
 from pushjax.paper import runner, spec as spec_lib
-from pushjax.train import convergence, evaluate
+from pushjax.train import convergence
 
 NAME = "data_efficiency_full"
 FULL = 190_080
@@ -190,47 +192,40 @@ def read_training_examples(source, fields: Sequence[str], units: Sequence[Unit])
 
 def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: TrainingExamples, validation: Mapping,
                test: Mapping, criterion: convergence.Criterion = convergence.CRITERION,
-               log: Callable[[str], None] | None = None, tensorboard_dir: str | Path | None = None,
-               checkpoint_dir: str | Path | None = None, resume_dir: str | Path | None = None,
-               provenance: Mapping[str, str] | None = None) -> dict:
-    """Trains and evaluates one model; returns its record. With `tensorboard_dir`, the model's scores go to the
-    TensorBoard run ``<tensorboard_dir>/<unit key>/train`` (from the step it resumes at); with `checkpoint_dir`, its
-    parameters to a checkpoint there (`pushjax.train.predictor.save_model`, replacing any earlier one); with
-    `resume_dir`, its training state is saved there as it trains and a later call continues from it
-    (`pushjax.train.convergence.train_until_converged`). `provenance` is the code's commit (and the diff of changed
-    code, `pushjax.provenance.write_source_diff`) as the run started; None: the checkout's commit now."""
+               log: Callable[[str], None] | None = None, checkpoint_dir: str | Path | None = None,
+               resume_dir: str | Path | None = None, provenance: Mapping[str, str] | None = None) -> dict:
+    """Trains and evaluates one model by `criterion` (`pushjax.train.sweep`, one model); returns its record. With
+    `checkpoint_dir`, its parameters go to a checkpoint there (`pushjax.train.predictor.save_model`, replacing any
+    earlier one); with `resume_dir`, it trains in that work directory of the trainer (its training state saved at
+    every score, ``metrics.csv`` every score, TensorBoard) and a later call continues from it. `provenance` is the
+    code's commit (and the diff of changed code, `pushjax.provenance.write_source_diff`) as the run started; None:
+    the checkout's commit now."""
     model_spec = train_examples.model_spec(unit)
     size = len(model_spec.train_indices)
-    config = train_config(spec, unit)
+    config = dataclasses.replace(train_config(spec, unit), log_every=criterion.eval_every)
     started = datetime.datetime.now(datetime.timezone.utc)
-    resumed = convergence.resumed_step(resume_dir)
+    resumed = train_lib.resumed_step(resume_dir)
     if resumed and log is not None:
         log(f"continues from step {resumed}")
-    tensorboard = (None if tensorboard_dir is None else train_lib.metrics_log.TensorBoardLog(
-        tensorboard_dir, [unit.key], "train", first_step=resumed))
-    try:
-        trained = convergence.train_until_converged(config, train_examples.examples, model_spec, validation, criterion,
-                                                    log=log, tensorboard=tensorboard, resume_dir=resume_dir)
-    finally:
-        if tensorboard is not None:
-            tensorboard.close()
+    trained = train_lib.sweep(config, train_examples.examples, [model_spec], resume_dir, mode=spec.mode,
+                              progress=False, criterion=criterion, validation=validation, log=log, keep_checkpoints=1)
+    phases, state = trained.phases, trained.model_state(0)
     if checkpoint_dir is not None:
         shutil.rmtree(checkpoint_dir, ignore_errors=True)  # a model killed before its record was written
-        train_lib.predictor.save_model(checkpoint_dir, trained.steps, config.model, model_spec, trained.state)
+        train_lib.predictor.save_model(checkpoint_dir, phases.steps, config.model, model_spec, state)
     clock = time.monotonic()
-    metrics = evaluate.evaluate(trained.model, trained.state, test, config.eval_batch_size)
-    row = {"model": unit.model, "kind": "trained", "train_split": "train", "test_split": "test",
-           "train_size": size, "seed": unit.seed, "l_scale": 1.0, "steps": trained.steps,
-           "converged": trained.converged, "constant_steps": trained.constant_steps,
-           "decay_steps": trained.decay_steps, **metrics}
+    (metrics,) = trained.evaluate(test, config.eval_batch_size)
+    row = runner.trained_row(unit.model, "train", "test", model_spec, 1.0, phases.steps, metrics,
+                             converged=phases.converged, constant_steps=phases.constant_steps,
+                             decay_steps=phases.decay_steps)
     return outputs.compact({
         "key": unit.key, "unit": dataclasses.asdict(unit), "row": runner.finite_or_none(row),
         "validation": [{"step": step, "trans_percent": trans, "rot_percent": rot}
-                       for step, trans, rot in trained.validation],
+                       for step, trans, rot in phases.validation],
         "criterion": dataclasses.asdict(criterion), "budget": criterion.budget(size),
-        "parameters": int(sum(np.size(leaf) for leaf in jax.tree.leaves(trained.state.params))),
-        "train_seconds": round(trained.seconds, 1), "eval_seconds": round(time.monotonic() - clock, 1),
-        "steps_per_second": trained.steps_per_second, "started": started.isoformat(timespec="seconds"),
+        "parameters": int(sum(np.size(leaf) for leaf in jax.tree.leaves(state.params))),
+        "train_seconds": round(phases.seconds, 1), "eval_seconds": round(time.monotonic() - clock, 1),
+        "steps_per_second": phases.steps_per_second, "started": started.isoformat(timespec="seconds"),
         "device": device_description(),
         **(provenance if provenance is not None else
            ({"commit": commit} if (commit := provenance_lib.git_commit()) else {})),
@@ -325,7 +320,6 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
                 try:
                     record = train_unit(spec, unit, train_examples, validation, test, criterion,
                                         lambda line, key=unit.key: log(f"[{key}] {line}"),
-                                        workdir / train_lib.metrics_log.TENSORBOARD_DIR,
                                         workdir / CHECKPOINTS / unit.key, workdir / IN_TRAINING / unit.key,
                                         provenance)
                 except BaseException:

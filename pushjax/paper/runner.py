@@ -1,7 +1,10 @@
-"""The one orchestrator: train the models of an `ExperimentSpec`, evaluate them and the baselines, write results.
+"""The paper's experiments: train the models of an `ExperimentSpec` in sweeps, evaluate them and the baselines, write
+results.
 
-Every binary under ``experiments/`` (the paper's experiments, ``train`` and ``visualize``) calls `run`. It writes
-``results.json`` to the work directory, in one schema everywhere::
+The binaries of the paper's experiments under ``experiments/`` (and ``train`` and ``visualize``) call `run`; the
+paper-composition run (`pushjax.paper.full_run`) trains one model at a time by a stopping rule instead, with the same
+trainer (`pushjax.train.sweep`) and the same rows (`trained_row`). `run` writes ``results.json`` to the work directory,
+in one schema everywhere::
 
     {"name": <the experiment>,
      "config": <ExperimentSpec.to_json(): the dataset and training configs, splits, sizes, seeds, ...>,
@@ -203,16 +206,23 @@ def plan_sweeps(spec: ExperimentSpec, train_splits: Sequence[str]) -> list[Plann
             for number, (l_scale, train_split, variants) in enumerate(keys, start=1)]
 
 
+def trained_row(model: str, train_split: str, test_split: str, spec: train_lib.ModelSpec, l_scale: float, steps: int,
+                metrics: Mapping, **training) -> dict:
+    """The ``results.json`` row of one trained model (`spec`'s subset and seed, `steps` trained) on `test_split`:
+    `metrics` of `pushjax.train.evaluate.evaluate`, after `training`'s fields (e.g. a criterion's verdict)."""
+    return {"model": model, "kind": "trained", "train_split": train_split, "test_split": test_split,
+            "train_size": len(spec.train_indices), "seed": spec.seed, "l_scale": l_scale, "steps": steps, **training,
+            **metrics}
+
+
 def _trained_rows(spec: ExperimentSpec, sweep: TrainedSweep, test_sets: Mapping[str, Examples]) -> list[dict]:
     result = sweep.result
     rows = []
     for test_split, examples in test_sets.items():
-        metrics = evaluate.evaluate_sweep(result, examples, spec.train.eval_batch_size)
+        metrics = result.evaluate(examples, spec.train.eval_batch_size)
         for k, (model, model_metrics) in enumerate(zip(result.specs, metrics)):
-            rows.append({"model": model.variant or sweep.variants[0], "kind": "trained",
-                         "train_split": sweep.train_split, "test_split": test_split,
-                         "train_size": len(model.train_indices), "seed": model.seed, "l_scale": sweep.l_scale,
-                         "steps": int(result.steps_trained[k]), **model_metrics})
+            rows.append(trained_row(model.variant or sweep.variants[0], sweep.train_split, test_split, model,
+                                    sweep.l_scale, int(result.steps_trained[k]), model_metrics))
     return rows
 
 

@@ -1,10 +1,14 @@
-"""Training: losses, one model's train state and step, the sweep trainer of K models, checkpoints,
-the metrics log, evaluation and training configs.
+"""Training: losses, one model's train state and step, the one trainer of K models (a fixed number of steps or a
+convergence criterion), checkpoints, the metrics log, evaluation and training configs.
 
 Modules:
   batching: each model's training subset and seed (`ModelSpec`), its batch order and in-memory batches.
   train_state: `TrainState`, the optimiser and the pure single-model train step.
-  sweep_trainer: `sweep`, training K models together (vmapped, unrolled or sequential), resumable.
+  sweep_trainer: `sweep`, the one trainer: K models together (vmapped, unrolled or sequential), for a fixed number
+    of steps or by a `convergence.Criterion`, resumable.
+  steppers: the sweep's jitted train step and one stepper per mode.
+  convergence: the stopping rules of one model: the convergence criterion and the paper's fixed budget.
+  stopping: the trend rule on a validation curve (and its continuation rule).
   mesh: the sweep's model axis split over a mesh of devices (K/D models per device).
   distributed: several processes (hosts) joined to train one sweep.
   checkpoint: orbax checkpoints of a (stacked) train state.
@@ -18,6 +22,7 @@ from pushjax.train import (
     batching,
     checkpoint,
     configs,
+    convergence,
     curves,
     distributed,
     evaluate,
@@ -25,6 +30,7 @@ from pushjax.train import (
     mesh,
     metrics_log,
     predictor,
+    steppers,
     sweep_trainer,
     train_state,
 )
@@ -41,12 +47,14 @@ from pushjax.train.batching import (
 from pushjax.train.configs import TrainConfig, get_config
 from pushjax.train.predictor import Prediction, Predictor, load_model, save_model
 from pushjax.train.train_state import TrainState, create_train_state, make_optimizer, make_train_step
-from pushjax.train.sweep_trainer import SWEEP_MODES, SweepResult, describe_specs, sweep
+from pushjax.train.steppers import SWEEP_MODES
+from pushjax.train.sweep_trainer import Phases, SweepResult, describe_specs, resumed_step, sweep
 
 __all__ = [
     "batching",
     "checkpoint",
     "configs",
+    "convergence",
     "curves",
     "distributed",
     "evaluate",
@@ -54,12 +62,14 @@ __all__ = [
     "mesh",
     "metrics_log",
     "predictor",
+    "steppers",
     "sweep_trainer",
     "train_state",
     "EVALUATION_FIELDS",
     "MODEL_INPUT_FIELDS",
     "SWEEP_MODES",
     "ModelSpec",
+    "Phases",
     "Prediction",
     "Predictor",
     "SweepResult",
@@ -76,6 +86,7 @@ __all__ = [
     "make_optimizer",
     "make_train_step",
     "model_fields",
+    "resumed_step",
     "subset_specs",
     "sweep",
 ]

@@ -1,9 +1,10 @@
-"""Training one model until a convergence criterion on its validation score is met (issue 30).
+"""When a model's training ends: a convergence criterion on its validation score, or a fixed budget (issue 30).
 
 The published runs train for a fixed number of steps with a cosine decay, whose end makes every learning curve look
-flat. `train_until_converged` instead trains one model at a constant learning rate and scores it on a fixed
-validation set every `Criterion.eval_every` steps; the score is the findings' (`pushjax.paper.statistics.SCORE`):
-the mean of the translation and rotation errors in % of the ``zero`` baseline.
+flat. A `Criterion` instead is a stopping rule of the one trainer (`pushjax.train.sweep_trainer.sweep`, its
+``criterion``): the model trains at a constant learning rate and is scored on a fixed validation set every
+`Criterion.eval_every` steps; the score is the findings' (`pushjax.paper.statistics.SCORE`): the mean of the
+translation and rotation errors in % of the ``zero`` baseline (`pushjax.train.evaluate.validation_errors`).
 
 **The criterion** (fixed before the run it judges): the constant phase ends at the first evaluation at which the
 best score of the last `Criterion.window` evaluations is not better than the best score before them by more than
@@ -16,37 +17,19 @@ phase, at least `Criterion.min_decay_steps`), and the model after the decay is t
 **A fixed budget** (`Criterion.stop_on_plateau` False, e.g. `PAPER_SCHEDULE`): the validation score is recorded every
 `Criterion.eval_every` steps and used for nothing; the constant phase lasts the whole budget, with no decay when
 `decay_fraction` and `min_decay_steps` are 0. Such a model can be continued to a larger budget from its saved state:
-a call with the same `resume_dir` and a criterion with a larger budget reopens the constant phase where it ended.
+the trainer with the same work directory and a criterion with a larger budget reopens the constant phase where it
+ended.
 
-One model per call: the unit of work of a resumable run whose finished models are recorded as they finish
-(`pushjax.paper.full_run`). With a `resume_dir` the model's training state, its scores and the criterion's progress
-are saved every `Criterion.eval_every` steps (constant phase and decay), and a call with the same folder continues
-from the last save: the batches depend only on the model's spec and the step, so a resumed model ends with the same
-parameters, scores and verdict as an uninterrupted one.
+This module holds the rules only (no JAX); the trainer saves the criterion's progress with the training state every
+`Criterion.eval_every` steps, so a resumed model ends with the same parameters, scores and verdict as an
+uninterrupted one.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
-import os
-import time
-from collections.abc import Callable, Sequence
-from pathlib import Path
-
-import jax
-import jax.numpy as jnp
-import numpy as np
-import optax
-
-from pushjax.models import ModelConfig, PushModel
-from pushjax.train.batching import Examples, ModelSpec, batch_indices, gather, model_fields
-from pushjax.train.checkpoint import Checkpointer
-from pushjax.train.configs import TrainConfig
-from pushjax.train.evaluate import error_metrics, predict
-from pushjax.train.metrics_log import TensorBoardLog
-from pushjax.train.train_state import TrainState, create_train_state, make_train_step
+from collections.abc import Sequence
 
 
 @dataclasses.dataclass(frozen=True)
@@ -103,6 +86,13 @@ class Criterion:
     def decay_steps(self, constant_steps: int) -> int:
         return max(self.min_decay_steps, int(round(self.decay_fraction * constant_steps)))
 
+    def decayed_learning_rate(self, learning_rate: float, step: int, constant_steps: int) -> float:
+        """The learning rate of the decay's step from `step` to ``step + 1`` after `constant_steps` at
+        `learning_rate`: a cosine from it to `final_lr_fraction` of it, reached at the decay's last step."""
+        fraction = (step - constant_steps + 1) / self.decay_steps(constant_steps)
+        cosine = 0.5 * (1.0 + math.cos(math.pi * fraction))
+        return learning_rate * (self.final_lr_fraction + (1 - self.final_lr_fraction) * cosine)
+
 
 CRITERION = Criterion()
 """The criterion of the ``data_efficiency_full`` run, fixed before it."""
@@ -122,171 +112,3 @@ def fixed_budget(steps: int) -> Criterion:
     if steps < 1:
         raise ValueError(f"steps: expected a positive integer, got {steps}")
     return dataclasses.replace(PAPER_SCHEDULE, base_steps=steps, max_steps=steps)
-
-
-@dataclasses.dataclass(frozen=True)
-class ConvergedModel:
-    """Outcome of `train_until_converged`.
-
-    Attributes:
-      model: the Flax module.
-      state: the trained `TrainState` (after the decay).
-      converged: whether the criterion ended the constant phase (False: its budget did).
-      constant_steps: steps at the constant learning rate.
-      decay_steps: steps of the decay.
-      validation: [(step, trans_percent, rot_percent)] every validation evaluation (its score: their mean), the one
-        after the decay last.
-      seconds: wall time of the training and its validation scores (of every call, when resumed).
-      steps_per_second: training steps per second (validation excluded).
-    """
-
-    model: PushModel
-    state: TrainState
-    converged: bool
-    constant_steps: int
-    decay_steps: int
-    validation: list[tuple[int, float, float]]
-    seconds: float
-    steps_per_second: float
-
-    @property
-    def steps(self) -> int:
-        return self.constant_steps + self.decay_steps
-
-
-def validation_errors(model: PushModel, state: TrainState, examples: Examples, batch_size: int) -> tuple[float, float]:
-    """The translation and rotation errors in % of zero of `state` on `examples`; their mean is the score."""
-    metrics = error_metrics(predict(model, state, examples, batch_size), examples)
-    return float(metrics["trans_percent"]), float(metrics["rot_percent"])
-
-
-def _with_learning_rate(state: TrainState, value: float) -> TrainState:
-    opt_state = state.opt_state
-    hyperparams = dict(opt_state.hyperparams, learning_rate=jnp.asarray(value, jnp.float32))
-    return state.replace(opt_state=opt_state._replace(hyperparams=hyperparams))
-
-
-@functools.lru_cache(maxsize=16)
-def _compiled_step(model_config: ModelConfig, physics: Callable | None, learning_rate: float, weight_decay: float):
-    """(model, optimiser, jitted train step) of `train_until_converged`: cached, so that the models of a run that
-    share an architecture (e.g. one variant at several training-set sizes) compile their step once."""
-    model = PushModel(model_config) if physics is None else PushModel(model_config, physics)
-    optimizer = optax.inject_hyperparams(optax.adam)(learning_rate=learning_rate)
-    return model, optimizer, jax.jit(make_train_step(model, optimizer, weight_decay))
-
-
-def resumed_step(resume_dir: str | os.PathLike | None) -> int:
-    """The step at which `train_until_converged` with this `resume_dir` continues (0: nothing saved)."""
-    if resume_dir is None or not Path(resume_dir).is_dir():
-        return 0
-    checkpointer = Checkpointer(resume_dir)
-    try:
-        return checkpointer.latest_step() or 0
-    finally:
-        checkpointer.close()
-
-
-def train_until_converged(
-    train_config: TrainConfig, examples: Examples, spec: ModelSpec, validation: Examples,
-    criterion: Criterion = CRITERION, *, physics: Callable | None = None,
-    log: Callable[[str], None] | None = None, tensorboard: TensorBoardLog | None = None,
-    resume_dir: str | os.PathLike | None = None,
-) -> ConvergedModel:
-    """Trains one model (`train_config.model`, the subset and seed of `spec`) by `criterion`.
-
-    Args:
-      train_config: model, learning rate (the constant one), batch size, weight decay, evaluation batch size; its
-        `num_steps` and `schedule` are not used (the criterion sets them).
-      examples: the training split, {field: [N, ...]}.
-      spec: the model's training subset and seed (its batches as in `pushjax.train.sweep`).
-      validation: the examples of the validation score.
-      criterion: the convergence criterion and budget.
-      physics: replaces `PushModel.physics`.
-      log: called with a line after every validation score.
-      tensorboard: a log of this one model (`pushjax.train.metrics_log.TensorBoardLog`, its first step
-        `resumed_step(resume_dir)`) that gets every validation score (``validation/trans_percent``,
-        ``validation/rot_percent``, ``validation/score``), the training loss and the steps per second of the constant
-        phase, or None.
-      resume_dir: a folder for the training state every `Criterion.eval_every` steps, from which a later call with the
-        same arguments continues (None: not saved). The caller removes it once the model is kept elsewhere.
-    """
-    model, optimizer, step_fn = _compiled_step(train_config.model, physics, train_config.learning_rate,
-                                               train_config.weight_decay)
-    fields = model_fields(train_config.model)
-    size = len(spec.train_indices)
-
-    def batch_at(step):
-        return gather(examples, batch_indices(spec, step, train_config.batch_size), fields)
-
-    state = create_train_state(model, optimizer, batch_at(0), spec.seed)
-    state = _with_learning_rate(state, train_config.learning_rate)
-    budget = criterion.budget(size)
-    step = 0
-    progress = {"scores": [], "validation": [], "converged": False, "constant_steps": None, "train_seconds": 0.0,
-                "seconds": 0.0}
-    checkpointer = None if resume_dir is None else Checkpointer(resume_dir, max_to_keep=1)
-    if checkpointer is not None and (restored := checkpointer.restore_latest(state)) is not None:
-        step, state, progress = restored
-        if not criterion.stop_on_plateau and progress["constant_steps"] is not None \
-                and progress["constant_steps"] < budget and step == progress["constant_steps"]:
-            progress = {**progress, "constant_steps": None}  # a fixed budget continued to a larger one
-    scores: list[float] = list(progress["scores"])
-    history: list[tuple[int, float, float]] = [tuple(point) for point in progress["validation"]]
-    converged, constant_steps = bool(progress["converged"]), progress["constant_steps"]
-    started, train_seconds = time.monotonic(), float(progress["train_seconds"])
-    metrics = None
-
-    def score_now(label: str, scalars: dict[str, float]) -> float:
-        trans, rot = validation_errors(model, state, validation, train_config.eval_batch_size)
-        score = (trans + rot) / 2.0
-        history.append((step, trans, rot))
-        if tensorboard is not None:
-            scalars = {**scalars, "validation/trans_percent": trans, "validation/rot_percent": rot,
-                       "validation/score": score}
-            tensorboard.append(step, {tag: np.array([value]) for tag, value in scalars.items()})
-        if log is not None:
-            log(f"{spec.name}: step {step} ({label}) validation score {score:.2f}")
-        return score
-
-    def save():
-        if checkpointer is not None:
-            checkpointer.save(step, state, {
-                "scores": scores, "validation": history, "converged": converged, "constant_steps": constant_steps,
-                "train_seconds": train_seconds, "seconds": progress["seconds"] + time.monotonic() - started})
-
-    try:
-        while constant_steps is None:
-            chunk = time.monotonic()
-            for _ in range(criterion.eval_every):
-                state, metrics = step_fn(state, batch_at(step))
-                step += 1
-            jax.block_until_ready(state.params)
-            train_seconds += time.monotonic() - chunk
-            scores.append(score_now("constant", {"loss": float(metrics["loss"]), "steps_per_second":
-                                                 criterion.eval_every / (time.monotonic() - chunk)}))
-            converged = criterion.plateaued(scores)
-            if converged or step >= budget:
-                constant_steps = step
-            save()
-        decay_steps = criterion.decay_steps(constant_steps)
-        lr = train_config.learning_rate
-        while step < constant_steps + decay_steps:
-            chunk = time.monotonic()
-            for _ in range(min(criterion.eval_every, constant_steps + decay_steps - step)):
-                progress_fraction = (step - constant_steps + 1) / decay_steps
-                cosine = 0.5 * (1.0 + math.cos(math.pi * progress_fraction))
-                state = _with_learning_rate(state, lr * (criterion.final_lr_fraction
-                                                         + (1 - criterion.final_lr_fraction) * cosine))
-                state, metrics = step_fn(state, batch_at(step))
-                step += 1
-            jax.block_until_ready(state.params)
-            train_seconds += time.monotonic() - chunk
-            save()
-    finally:
-        if checkpointer is not None:
-            checkpointer.close()
-    if decay_steps or not history or history[-1][0] != step:
-        score_now("after the decay", {"loss": float(metrics["loss"])} if metrics is not None else {})
-    return ConvergedModel(model, state, converged, constant_steps, decay_steps, history,
-                          progress["seconds"] + time.monotonic() - started,
-                          step / train_seconds if train_seconds > 0 else float("nan"))

@@ -26,10 +26,9 @@ import numpy as np
 
 from pushjax import planar
 from pushjax.stats import SEQUENCE_RATIOS, bootstrap_replicates
-from pushjax.models import ERROR_OPTIONS, PushModel
+from pushjax.models import PushModel
 from pushjax.physics import lynch
 from pushjax.train.batching import Examples, model_fields
-from pushjax.train.sweep_trainer import SweepResult
 from pushjax.train.train_state import TrainState
 
 
@@ -175,12 +174,9 @@ def evaluate(
     return error_metrics(predict(model, state, examples, batch_size, error_options), examples)
 
 
-def evaluate_sweep(result: SweepResult, examples: Examples, batch_size: int = 256) -> list[dict]:
-    """`evaluate` for every model of a sweep, in the order of `result.specs`."""
-    return [
-        evaluate(
-            result.model, result.model_state(k), examples, batch_size,
-            None if spec.variant is None else np.asarray(ERROR_OPTIONS[spec.variant], np.float32),
-        )
-        for k, spec in enumerate(result.specs)
-    ]
+def validation_errors(model: PushModel, state: TrainState, examples: Examples, batch_size: int,
+                      error_options: np.ndarray | None = None) -> tuple[float, float]:
+    """The translation and rotation errors in % of zero of one model on `examples` (arguments as in `predict`): the
+    validation score of a `pushjax.train.convergence.Criterion` is their mean."""
+    metrics = error_metrics(predict(model, state, examples, batch_size, error_options), examples)
+    return float(metrics["trans_percent"]), float(metrics["rot_percent"])

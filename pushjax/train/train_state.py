@@ -1,6 +1,6 @@
 """One model's optimisation: its train state, the paper's optimiser, and the pure train step.
 
-The sweep trainer (`pushjax.train.sweep_trainer`) jits, vmaps or unrolls `make_train_step` over the
+The one trainer (`pushjax.train.sweep_trainer.sweep`) jits, vmaps or unrolls `make_train_step` over the
 models of a sweep.
 """
 
@@ -40,8 +40,8 @@ SCHEDULES = ("constant", "cosine")
 """Learning-rate schedules of `make_optimizer`."""
 
 
-def make_optimizer(learning_rate: float, schedule: str = "constant",
-                   num_steps: int | None = None) -> optax.GradientTransformation:
+def make_optimizer(learning_rate: float, schedule: str = "constant", num_steps: int | None = None,
+                   adjustable: bool = False) -> optax.GradientTransformation:
     """Adam with step size `learning_rate` (> 0): constant (the paper's) or decayed.
 
     Args:
@@ -49,7 +49,14 @@ def make_optimizer(learning_rate: float, schedule: str = "constant",
       schedule: ``"constant"``, or ``"cosine"``: a cosine decay from `learning_rate` to 1 % of it over `num_steps`
         (after which it stays there).
       num_steps: the decay's length in steps (``"cosine"`` only).
+      adjustable: the step size a hyperparameter of the optimiser's state (``opt_state.hyperparams
+        ["learning_rate"]``, `optax.inject_hyperparams`), which the trainer sets step by step (a
+        `pushjax.train.convergence.Criterion`'s decay); ``"constant"`` only.
     """
+    if adjustable:
+        if schedule != "constant":
+            raise ValueError(f"schedule: an adjustable learning rate starts constant, got {schedule!r}")
+        return optax.inject_hyperparams(optax.adam)(learning_rate=learning_rate)
     if schedule == "constant":
         return optax.adam(learning_rate)
     if schedule == "cosine":

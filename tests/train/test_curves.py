@@ -19,8 +19,9 @@ def _sweep(config, examples, validation, workdir):
 
 
 def test_curves_at_every_checkpoint_and_resume_to_the_same_file(smoke, tmp_path):
-    config = dataclasses.replace(TINY_SMOKE.with_variant("hybrid"), num_steps=40, checkpoint_every=20,
-                                 learning_rate=3e-3, log_every=20)
+    # TINY_SMOKE's learning rate: the single-model step the other hybrid sweeps of tests/train compile (predictor,
+    # tensorboard, the mesh and 2-process references), one program for all; the errors fall by a fifth in 40 steps.
+    config = dataclasses.replace(TINY_SMOKE.with_variant("hybrid"), num_steps=40, checkpoint_every=20, log_every=20)
     examples, validation = smoke["train"], smoke["validation"]
     _sweep(config, examples, validation, tmp_path / "whole")
     rows = curves.read(tmp_path / "whole" / "curves.csv")

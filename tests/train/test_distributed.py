@@ -14,7 +14,7 @@ import pytest
 
 from pushjax import train
 from pushjax.train import distributed
-from tests.train.test_mesh import CONFIG, assert_equals_sequential
+from tests.train.test_mesh import CHILD_XLA_FLAGS, CONFIG, assert_equals_sequential
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 SPECS = train.subset_specs(256, [30, 60, 100], [0])
@@ -66,7 +66,7 @@ def _free_port() -> int:
 
 def test_sweep_on_2_processes_equals_the_sequential_sweep_on_one_device(examples, tmp_path):
     np.savez(tmp_path / "examples.npz", **{name: examples[name] for name in train.model_fields(CONFIG.model)})
-    flags = f"{os.environ.get('XLA_FLAGS', '')} --xla_force_host_platform_device_count=2".strip()
+    flags = f"{os.environ.get('XLA_FLAGS', '')} --xla_force_host_platform_device_count=2 {CHILD_XLA_FLAGS}".strip()
     address = f"127.0.0.1:{_free_port()}"
     logs = [tmp_path / f"process{index}.log" for index in range(2)]
     children = []

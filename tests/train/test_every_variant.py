@@ -10,7 +10,6 @@ import pytest
 
 from pushjax import train
 from pushjax.models import VARIANTS
-from pushjax.train import evaluate
 from tests.tiny_configs import TINY_SMOKE as SMOKE
 
 ERROR_VARIANTS = ("error", "error_grad", "error_norm")
@@ -39,6 +38,6 @@ def test_every_variant_learns_without_nan(variants, view, smoke, smoke_viewpoint
         rows = list(csv.DictReader(file))
     assert sorted({int(row["step"]) for row in rows}) == list(range(20, NUM_STEPS + 1, 20))
     assert len(rows) == NUM_STEPS // 20 * len(variants)
-    for metrics in evaluate.evaluate_sweep(result, splits["test"], batch_size=64):
+    for metrics in result.evaluate(splits["test"], batch_size=64):
         assert np.isfinite(metrics["trans_percent"]) and np.isfinite(metrics["rot_percent"])
     np.testing.assert_array_equal(result.steps_trained, [NUM_STEPS] * len(variants))

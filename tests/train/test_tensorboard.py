@@ -93,12 +93,11 @@ def test_a_model_trained_to_convergence_logs_its_validation_scores(examples, tmp
     spec, = train.subset_specs(len(examples["motion"]), [20], [0])
     criterion = convergence.Criterion(eval_every=2, window=2, base_steps=4, steps_per_example=0, max_steps=4,
                                       min_decay_steps=1)
-    log = metrics_log.TensorBoardLog(tmp_path, [spec.name], "train", first_step=0)
-    trained = convergence.train_until_converged(CONFIG, examples, spec, examples, criterion, tensorboard=log)
-    log.close()
-    scalars = _scalars(tmp_path / spec.name / "train")
-    assert [step for step, _, _ in trained.validation] == sorted(
+    trained = train.sweep(CONFIG, examples, [spec], tmp_path, mode="sequential", progress=False, criterion=criterion,
+                          validation=examples)
+    scalars = _scalars(tmp_path / metrics_log.TENSORBOARD_DIR / spec.name / "train")
+    assert [step for step, _, _ in trained.phases.validation] == sorted(
         step for tag, step in scalars if tag == "validation/score")
-    for step, trans, rot in trained.validation:
+    for step, trans, rot in trained.phases.validation:
         assert scalars[("validation/trans_percent", step)] == pytest.approx(trans, rel=1e-6)
         assert scalars[("validation/rot_percent", step)] == pytest.approx(rot, rel=1e-6)

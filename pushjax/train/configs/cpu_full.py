@@ -2,7 +2,7 @@
 
 Adam at a constant 10^-3 until the validation score stops improving (`pushjax.train.convergence.CRITERION`), then a
 short cosine decay to 10^-5; `num_steps` is the budget's cap at the full split (the criterion's budget grows with the
-training-set size). `pushjax.paper.full_run` trains with `pushjax.train.convergence.train_until_converged`.
+training-set size). `pushjax.paper.full_run` trains with `pushjax.train.sweep` under that criterion.
 """
 
 import dataclasses
