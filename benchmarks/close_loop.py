@@ -28,7 +28,7 @@ import jax
 
 from pushjax import compilation_cache
 from pushjax.loop import close_loop
-from pushjax.sim.dataset import RecordingSettings, record_pushes
+from pushjax.sim.dataset import RecordingConfig, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.testbed import IDEAL
 
@@ -55,7 +55,7 @@ def main():
         data_dir = args.data_dir or Path(scratch) / "pushes"
         workdir = args.workdir or Path(scratch) / "loop"
         start = time.perf_counter()
-        settings = RecordingSettings(seed=args.seed, velocities=VELOCITIES, effects=Effects.parse(args.effects),
+        settings = RecordingConfig(seed=args.seed, velocities=VELOCITIES, effects=Effects.parse(args.effects),
                                      declare_effects=False, testbed=IDEAL)
         recorded = record_pushes(data_dir, OBJECTS, SURFACES, args.pushes_per_pair, settings, workers=args.workers,
                                  progress=True)

@@ -57,7 +57,7 @@ from pushjax.loop.pipeline import LoopConfig, decide
 from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes
 from pushjax.physics.effects import support_pressure
-from pushjax.sim.dataset import RecordingSettings, record_pushes
+from pushjax.sim.dataset import RecordingConfig, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.testbed import IDEAL
 
@@ -108,7 +108,7 @@ def analyse(data_dir: Path, setup: str, case: str, seed: int, cached_only: bool 
     support, effects, start_poses = CASES[case]
     pushes = data_dir / case / f"seed{seed}"
     objects, surfaces, velocities, _ = SETUPS[setup]
-    settings = RecordingSettings(seed=seed, velocities=velocities, effects=Effects.parse(effects),
+    settings = RecordingConfig(seed=seed, velocities=velocities, effects=Effects.parse(effects),
                                  declare_effects=False, support=support, testbed=IDEAL, start_poses=start_poses)
     record_pushes(pushes, objects, surfaces, PUSHES_PER_OBJECT, settings, workers=1, progress=False)
     start = time.perf_counter()

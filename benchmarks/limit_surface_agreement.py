@@ -31,7 +31,7 @@ from pushjax.mit.files import iter_pushes
 from pushjax.physics import limit_surface, lynch
 from pushjax.planar import rotate
 from pushjax.sim import scene
-from pushjax.sim.dataset import RecordingSettings, record_pushes
+from pushjax.sim.dataset import RecordingConfig, record_pushes
 from pushjax.sim.testbed import IDEAL
 
 
@@ -52,7 +52,7 @@ def main():
     objects = args.objects.split(",")
     with tempfile.TemporaryDirectory() as scratch:
         data_dir = args.data_dir or Path(scratch) / "pushes"
-        settings = RecordingSettings(seed=args.seed, velocities=tuple(float(v) for v in args.velocities.split(",")),
+        settings = RecordingConfig(seed=args.seed, velocities=tuple(float(v) for v in args.velocities.split(",")),
                                      declare_effects=False, testbed=IDEAL)
         record_pushes(data_dir, objects, [args.surface], args.pushes, settings, workers=1, progress=True)
         examples, _ = build_examples(iter_pushes(data_dir), pusher_friction=scene.pusher_friction())

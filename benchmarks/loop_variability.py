@@ -22,7 +22,7 @@ from pushjax import outputs
 from pushjax.loop import variability
 from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes
-from pushjax.sim.dataset import RecordingSettings, record_pushes
+from pushjax.sim.dataset import RecordingConfig, record_pushes
 from pushjax.sim.testbed import IDEAL, REALISTIC
 
 GOAL = 0.25
@@ -31,7 +31,7 @@ GOAL = 0.25
 
 def measure(folder: Path, testbed, pushes: int, seed: int) -> dict:
     """Records (or reuses) `pushes` pushes in `folder` on `testbed`; the recovered spread beside the drawn one."""
-    record_pushes(folder, ["rect1"], ["pu"], pushes, RecordingSettings(seed=seed, velocities=(20.0,), testbed=testbed),
+    record_pushes(folder, ["rect1"], ["pu"], pushes, RecordingConfig(seed=seed, velocities=(20.0,), testbed=testbed),
                   workers=1, progress=True)
     recorded = list(iter_pushes(folder))
     examples, _ = build_examples(recorded)

@@ -25,7 +25,7 @@ def main():
 
     with tempfile.TemporaryDirectory() as root:
         # Plan once so that the timed run only simulates and writes.
-        settings = dataset.RecordingSettings(velocities=(args.velocity,), testbed=IDEAL)
+        settings = dataset.RecordingConfig(velocities=(args.velocity,), testbed=IDEAL)
         dataset.plan_pushes(root, [args.object], ["abs"], args.pushes, settings)
         start = time.perf_counter()
         summary = dataset.record_pushes(root, [args.object], ["abs"], args.pushes, settings, workers=args.workers,

@@ -39,7 +39,7 @@ from absl import app, flags
 import experiments
 from pushjax.geometry import OBJECT_NAMES
 from pushjax.sim import scene
-from pushjax.sim.dataset import START_POSES, OutDirConflictError, RecordingSettings, record_pushes
+from pushjax.sim.dataset import START_POSES, OutDirConflictError, RecordingConfig, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
 from pushjax.sim.testbed import from_flags
@@ -114,7 +114,7 @@ def main(argv):
     if len(argv) > 1:
         raise app.UsageError(f"unexpected arguments: {' '.join(argv[1:])}")
     try:
-        settings = RecordingSettings(
+        settings = RecordingConfig(
             seed=_SEED.value, velocities=_numbers("velocities", _VELOCITIES.value, 0.0, strict=True),
             accelerations=_numbers("accelerations", _ACCELERATIONS.value, 0.0, strict=False),
             repeats=_REPEATS.value, effects=Effects.parse(_EFFECTS.value), declare_effects=_DECLARE.value,

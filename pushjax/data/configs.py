@@ -85,7 +85,7 @@ import numpy as np
 from pushjax.geometry.objects import OBJECT_NAMES, get_object
 from pushjax.mit.files import PushParams, push_file_path
 from pushjax.mit.protocol import MIT_ANGLES, side_points
-from pushjax.sim.dataset import PushJob, RecordingSettings, plan_pushes
+from pushjax.sim.dataset import PushJob, RecordingConfig, plan_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import SURFACE_NAMES
 from pushjax.sim.testbed import DEFAULT_PROFILE, PROFILES, Testbed
@@ -281,7 +281,7 @@ def _key(*parts) -> list[int]:
 def _pool(obj: str, velocity: float, pushes: int, config: DatasetConfig, raw_dir: Path) -> list[PushJob]:
     """The recording jobs of ``pushes`` draws of ``obj`` at ``velocity`` on every configured surface."""
     return plan_pushes(raw_dir, [obj], list(config.surfaces), pushes,
-                       RecordingSettings(seed=config.seed, velocities=(velocity,), testbed=config.testbed_profile))
+                       RecordingConfig(seed=config.seed, velocities=(velocity,), testbed=config.testbed_profile))
 
 
 def _split_off(items: list, fraction: float, rng: np.random.Generator) -> tuple[list, list]:

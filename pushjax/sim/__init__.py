@@ -9,7 +9,7 @@ quasi-static model.
 """
 
 from pushjax.sim import dataset, effects, push, scene, surfaces, testbed
-from pushjax.sim.dataset import RecordingSettings, plan_pushes, record_pushes
+from pushjax.sim.dataset import RecordingConfig, plan_pushes, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.push import Recording, Simulator, simulate_push
 from pushjax.sim.scene import build_model, scene_xml, write_scene
@@ -21,7 +21,7 @@ __all__ = [
     "IDEAL",
     "REALISTIC",
     "Recording",
-    "RecordingSettings",
+    "RecordingConfig",
     "SURFACE_NAMES",
     "Simulator",
     "Testbed",

@@ -70,7 +70,7 @@ class OutDirConflictError(ValueError):
 
 
 @dataclasses.dataclass(frozen=True)
-class RecordingSettings:
+class RecordingConfig:
     """The settings that fix the bytes of every file recorded with them (the push counts, objects and surfaces
     choose which files).
 
@@ -194,12 +194,12 @@ def plan_pushes(
     objects: Sequence[str],
     surfaces: Sequence[str],
     pushes: int,
-    settings: RecordingSettings = RecordingSettings(),
+    settings: RecordingConfig = RecordingConfig(),
 ) -> list[PushJob]:
     """The files to record, in a deterministic order; arguments as in :func:`record_pushes`."""
     _check_selection(objects, surfaces, pushes)
-    if not isinstance(settings, RecordingSettings):
-        raise ValueError(f"settings: expected a RecordingSettings, got {type(settings).__name__}")
+    if not isinstance(settings, RecordingConfig):
+        raise ValueError(f"settings: expected a RecordingConfig, got {type(settings).__name__}")
     seed, effects, support, testbed = settings.seed, settings.effects, settings.support, settings.testbed
     jobs = []
     for obj in objects:
@@ -292,7 +292,7 @@ def record_pushes(
     objects: Sequence[str],
     surfaces: Sequence[str],
     pushes: int,
-    settings: RecordingSettings = RecordingSettings(),
+    settings: RecordingConfig = RecordingConfig(),
     workers: int | None = None,
     progress: bool = True,
 ) -> RecordSummary:
@@ -300,7 +300,7 @@ def record_pushes(
 
     Resumable: files that already exist and read as valid pushes (``pushjax.mit.read_raw_push``) are kept, invalid
     ones are recorded again. ``out_dir/pushjax_manifest.json`` (:data:`MANIFEST_NAME`) records the settings that fix
-    the files' bytes (:meth:`RecordingSettings.to_dict`); a call whose settings differ from it is refused (see the
+    the files' bytes (:meth:`RecordingConfig.to_dict`); a call whose settings differ from it is refused (see the
     module docstring).
 
     Args:

@@ -216,7 +216,7 @@ PROFILES = {"ideal": IDEAL, "realistic": REALISTIC}
 
 DEFAULT_PROFILE = "realistic"
 """The profile of every command (``--testbed``) and dataset config unless another is named; ``ideal`` is the clean
-reference; the library's recording settings (``pushjax.sim.dataset.RecordingSettings``) default to it too."""
+reference; the library's recording settings (``pushjax.sim.dataset.RecordingConfig``) default to it too."""
 
 FLAG_HELP = ("Testbed profile of the simulated pushes (pushjax.sim.testbed): realistic (the physics Lynch's model "
              "leaves out, calibrated against the paper) or ideal (pushes exactly as the model assumes).")

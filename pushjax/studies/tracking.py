@@ -207,7 +207,7 @@ def simulate_pushes(objects: Sequence[str], pushes: int, seed: int, testbed: Tes
         raise ValueError(f"rate_hz: expected {RECORDING_RATE_HZ} Hz divided by a whole number, got {rate_hz}")
     step = round(step)
     jobs = dataset.plan_pushes("unused", list(objects), ["abs"], pushes,
-                               dataset.RecordingSettings(seed=seed, velocities=(velocity,), testbed=testbed))
+                               dataset.RecordingConfig(seed=seed, velocities=(velocity,), testbed=testbed))
     result = []
     for job in tqdm.tqdm(jobs, unit="push", desc="track: simulating the pushes"):
         recording = dataset.simulate_job(job)

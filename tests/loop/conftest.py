@@ -12,7 +12,7 @@ from tests.conftest import _shared_folder, once_across_workers
 
 from pushjax.loop import LoopConfig, close_loop
 from pushjax.loop.fit import FitConfig
-from pushjax.sim.dataset import RecordingSettings, record_pushes
+from pushjax.sim.dataset import RecordingConfig, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
 from pushjax.sim.testbed import IDEAL
@@ -79,7 +79,7 @@ def record(tmp_path_factory):
 
     def get(name):
         root = shared / f"loop_pushes_{name}"
-        settings = RecordingSettings(seed=1, velocities=(20.0,), effects=CASES[name].effects, declare_effects=False,
+        settings = RecordingConfig(seed=1, velocities=(20.0,), effects=CASES[name].effects, declare_effects=False,
                                      testbed=IDEAL)
         return once_across_workers(root, lambda: record_pushes(root, ["rect1"], ["pu"], CASES[name].pushes, settings,
                                                                workers=1, progress=False))

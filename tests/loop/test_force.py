@@ -9,7 +9,7 @@ from pushjax.geometry import get_object
 from pushjax.loop import force
 from pushjax.loop.windows import build_examples, tracking_noise
 from pushjax.mit.files import iter_pushes
-from pushjax.sim.dataset import RecordingSettings, record_pushes
+from pushjax.sim.dataset import RecordingConfig, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
 from pushjax.sim.testbed import IDEAL
@@ -50,7 +50,7 @@ def test_a_turning_object_whose_contact_sticks_is_not_read_as_sliding(tmp_path):
     # At 40 mm/s the ellipse turns fast enough that its contact point moves around the round tip while the contact
     # sticks; those samples lie inside the cone. Only the tip's slip over the object counts as sliding, so every
     # push that slid reads the simulated coefficient (the touched point's motion along the outline read 0.22-0.6).
-    settings = RecordingSettings(seed=0, velocities=(40.0,), effects=Effects(pusher_friction=0.6),
+    settings = RecordingConfig(seed=0, velocities=(40.0,), effects=Effects(pusher_friction=0.6),
                                  declare_effects=False, testbed=IDEAL)
     record_pushes(tmp_path, ["ellip3"], ["delrin"], 12, settings, workers=1, progress=False)
     pushes = list(iter_pushes(tmp_path))

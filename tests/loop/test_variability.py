@@ -9,7 +9,7 @@ import pytest
 from pushjax.loop import variability
 from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes
-from pushjax.sim.dataset import RecordingSettings, record_pushes
+from pushjax.sim.dataset import RecordingConfig, record_pushes
 from pushjax.sim.testbed import IDEAL, REALISTIC
 
 
@@ -19,7 +19,7 @@ def test_the_pusher_friction_spread_is_recovered_from_the_force_sensor(profile, 
     # fields, tracking noise); about 30 of them slide long enough for a reading with a standard error. Without tracking
     # noise (ideal) the readings of one coefficient scatter more than their samples do: the floor of their error.
     testbed = profile.with_overrides(f"pusher_friction_sigma={sigma}")
-    record_pushes(tmp_path, ["rect1"], ["pu"], 40, RecordingSettings(seed=0, velocities=(20.0,), testbed=testbed),
+    record_pushes(tmp_path, ["rect1"], ["pu"], 40, RecordingConfig(seed=0, velocities=(20.0,), testbed=testbed),
                   workers=1, progress=False)
     examples, _ = build_examples(iter_pushes(tmp_path))
     found = variability.measure(examples)["pusher_friction"]

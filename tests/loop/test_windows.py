@@ -9,7 +9,7 @@ from pushjax.geometry import get_object
 from pushjax.loop.windows import VARIABLES, build_examples, split_by_sequence
 from pushjax.mit.files import iter_pushes, load_push
 from pushjax.physics.effects import PushInputs
-from pushjax.sim.dataset import RecordingSettings, record_pushes
+from pushjax.sim.dataset import RecordingConfig, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.testbed import IDEAL
 
@@ -73,7 +73,7 @@ def test_contacts_beyond_the_window_are_annotated_without_push(record):
 
 def test_effect_attributes_are_never_read(tmp_path):
     arguments = dict(objects=["tri1"], surfaces=["abs"], pushes=3, workers=1, progress=False)
-    settings = RecordingSettings(seed=2, velocities=(50.0,), effects=Effects(com_offset=(0.01, 0.0)), testbed=IDEAL)
+    settings = RecordingConfig(seed=2, velocities=(50.0,), effects=Effects(com_offset=(0.01, 0.0)), testbed=IDEAL)
     record_pushes(tmp_path / "declared", settings=settings, **arguments)
     record_pushes(tmp_path / "undeclared", settings=dataclasses.replace(settings, declare_effects=False), **arguments)
     declared, _ = build_examples(iter_pushes(tmp_path / "declared"))

@@ -20,9 +20,9 @@ from pushjax.sim.testbed import Testbed as Profile
 REPO = Path(__file__).resolve().parents[2]
 
 
-def ideal(**fields) -> dataset.RecordingSettings:
+def ideal(**fields) -> dataset.RecordingConfig:
     """Recording settings on the ideal testbed: the files recorded before testbeds existed, and fast."""
-    return dataset.RecordingSettings(**{"testbed": IDEAL, **fields})
+    return dataset.RecordingConfig(**{"testbed": IDEAL, **fields})
 
 
 def files(root: Path) -> dict[str, bytes]:
@@ -205,13 +205,13 @@ def test_plan_draws_distinct_pushes_and_checks_arguments(tmp_path):
         (dict(effects={}), "effects"),
     ]:
         with pytest.raises(ValueError, match=message):
-            dataset.RecordingSettings(**fields)
+            dataset.RecordingConfig(**fields)
     with pytest.raises(ValueError, match="workers"):
         dataset.record_pushes(tmp_path, ["rect1"], ["abs"], 1, workers=0)
 
 
 def test_the_library_records_on_the_realistic_testbed_like_every_command(tmp_path):
-    assert dataset.RecordingSettings().testbed == REALISTIC
+    assert dataset.RecordingConfig().testbed == REALISTIC
     assert all(job.testbed == REALISTIC for job in dataset.plan_pushes(tmp_path, ["rect1"], ["abs"], 2))
 
 

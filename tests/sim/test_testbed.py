@@ -263,7 +263,7 @@ def test_motion_capture_noise_jitter_and_drops():
 # Recording: deterministic, resumable, readable; the ideal profile is unchanged.
 
 SELECTION = dict(objects=["rect1"], surfaces=["abs"], pushes=2, progress=False)
-REALISTIC_RUN = dataset.RecordingSettings(seed=7, velocities=(20.0, 200.0), testbed=REALISTIC)
+REALISTIC_RUN = dataset.RecordingConfig(seed=7, velocities=(20.0, 200.0), testbed=REALISTIC)
 
 
 def files(root):
@@ -305,7 +305,7 @@ def test_realistic_recording_is_deterministic_readable_and_refuses_other_testbed
 
 def test_a_manifest_without_testbed_counts_as_ideal(tmp_path):
     run = dict(objects=["rect1"], surfaces=["abs"], pushes=1, workers=1, progress=False)
-    ideal = dataset.RecordingSettings(seed=1, velocities=(50.0,), testbed=IDEAL)
+    ideal = dataset.RecordingConfig(seed=1, velocities=(50.0,), testbed=IDEAL)
     dataset.record_pushes(tmp_path, settings=ideal, **run)
     manifest = tmp_path / dataset.MANIFEST_NAME
     content = json.loads(manifest.read_text())
@@ -322,7 +322,7 @@ def test_lynch_model_runs_on_realistic_files_and_errs_more(tmp_path):
     run = dict(objects=["rect1"], surfaces=["abs"], pushes=3, workers=1, progress=False)
     errors = {}
     for name, profile in (("ideal", IDEAL), ("realistic", REALISTIC)):
-        settings = dataset.RecordingSettings(seed=2, velocities=(20.0,), testbed=profile)
+        settings = dataset.RecordingConfig(seed=2, velocities=(20.0,), testbed=profile)
         summary = dataset.record_pushes(tmp_path / name, settings=settings, **run)
         shape = get_object("rect1")
         simulated, predicted = [], []
