@@ -1,9 +1,12 @@
-r"""Replays a convergence-criterion run's models under the trend stopping rule (`pushjax.paper.stopping_audit`).
+r"""Replays a run's models under the trend stopping rule (`pushjax.paper.stopping_audit`).
 
   python -m experiments.stopping_audit --run=results/data_efficiency_full --workdir=results/stopping_audit
+  python -m experiments.stopping_audit --run=results/data_efficiency_long --workdir=results/data_efficiency_long/continuation
 
 Writes results.json and results.md to --workdir: for every recorded model, whether it was still improving when the
-criterion stopped it, and whether the trend rule (`pushjax.train.stopping.RULE`) would have stopped it there.
+criterion stopped it, and whether the trend rule (`pushjax.train.stopping.RULE`) would have stopped it there; for
+the models of fixed budgets (the paper's 75 000 steps), per variant and size, whether the continuation rule
+(`pushjax.train.stopping.long_run_continues`) sends its seeds on to twice their steps.
 """
 
 from absl import app, flags
@@ -26,9 +29,14 @@ def main(argv):
     results = stopping_audit.audit(_RUN.value)
     stopping_audit.write(results, cli.WORKDIR.value)
     counts = results["counts"]
-    print(f"{counts['stopped_while_improving']} of the {counts['criterion_met']} models the criterion stopped were "
-          f"still improving; the trend rule would have kept training {counts['rule_would_not_stop']}; wrote "
-          f"{cli.WORKDIR.value}/results.json and results.md")
+    if counts["criterion_met"] or not results["continuations"]:
+        print(f"{counts['stopped_while_improving']} of the {counts['criterion_met']} models the criterion stopped "
+              f"were still improving; the trend rule would have kept training {counts['rule_would_not_stop']}")
+    print(f"wrote {cli.WORKDIR.value}/results.json and results.md")
+    for row in results["continuations"]:
+        print(f"{row['variant']} at {row['size']} (seeds {', '.join(map(str, row['seeds']))}, "
+              f"{max(row['steps'])} steps): " + (f"continues to {row['next_steps']} steps" if row["continues"] else
+                                                 "stops (the rule stops every seed)"))
 
 
 if __name__ == "__main__":

@@ -10,6 +10,10 @@ stopped it:
 * ``rule_stops``: the trend rule would have stopped there too (its upper bound on the gain below 0.5 points per
   10 000 steps); ``too_short``: fewer steps than the rule's window, so it could not have stopped yet;
 * ``first_stop``: the first evaluation at which the rule stops within the recorded curve (None: never).
+
+A run of fixed budgets (the paper's 75 000 steps, `pushjax.train.convergence.PAPER_SCHEDULE`) is judged by the
+continuation rule instead (`continuations`): per variant and size, each seed's trend at its last score and whether
+`pushjax.train.stopping.long_run_continues` sends the variant's seeds on to twice their steps.
 """
 
 from __future__ import annotations
@@ -23,13 +27,18 @@ from pushjax.paper import full_run
 from pushjax.train import stopping
 
 
+def _curve(record: Mapping) -> tuple[list[int], list[float]]:
+    """(steps, scores) of a record's constant-rate phase, the score the mean of translation and rotation."""
+    points = [point for point in record["validation"] if point["step"] <= record["row"]["constant_steps"]]
+    return [point["step"] for point in points], [(point["trans_percent"] + point["rot_percent"]) / 2.0
+                                                 for point in points]
+
+
 def audit_record(record: Mapping, rule: stopping.TrendRule = stopping.RULE) -> dict:
     """One model's row: its key, variant, size, seed, the criterion's stop and the trend rule's verdict there."""
     row = record["row"]
     stop = row["constant_steps"]
-    curve = [(point["step"], (point["trans_percent"] + point["rot_percent"]) / 2.0)
-             for point in record["validation"] if point["step"] <= stop]
-    steps, scores = [step for step, _ in curve], [score for _, score in curve]
+    steps, scores = _curve(record)
     trend, end = rule.trend(steps, scores), stopping.IMPROVING.trend(steps, scores, require_span=False)
     return {"key": record["key"], "variant": row["model"], "size": row["train_size"], "seed": row["seed"],
             "stopped_at": stop, "criterion_met": bool(row["converged"]), "too_short": trend is None,
@@ -40,9 +49,34 @@ def audit_record(record: Mapping, rule: stopping.TrendRule = stopping.RULE) -> d
             "first_stop": rule.first_stop(steps, scores)}
 
 
+def continuations(records: Mapping[str, Mapping], rule: stopping.TrendRule = stopping.RULE) -> list[dict]:
+    """Per (variant, size) of the fixed-budget `records` (their criterion's ``stop_on_plateau`` false), in key order:
+    the seeds, their steps, each one's trend over the rule's window at its last score and whether the rule stops it,
+    and ``continues``: `pushjax.train.stopping.long_run_continues` over the seeds (then ``next_steps``, twice the
+    most steps, else None)."""
+    groups: dict[tuple[str, int], list[Mapping]] = {}
+    for key in sorted(records):
+        record = records[key]
+        if not record["criterion"]["stop_on_plateau"]:
+            groups.setdefault((record["row"]["model"], record["row"]["train_size"]), []).append(record)
+    rows = []
+    for (variant, size), members in groups.items():
+        curves = [_curve(record) for record in members]
+        trends = [rule.trend(steps, scores) for steps, scores in curves]
+        continues = stopping.long_run_continues(curves, rule)
+        rows.append({"variant": variant, "size": size, "seeds": [record["row"]["seed"] for record in members],
+                     "steps": [record["row"]["steps"] for record in members],
+                     "trends": [None if trend is None else dataclasses.asdict(trend) for trend in trends],
+                     "rule_stops": [rule.stops(steps, scores) for steps, scores in curves], "continues": continues,
+                     "next_steps": 2 * max(record["row"]["steps"] for record in members) if continues else None})
+    return rows
+
+
 def audit(workdir: str | Path, rule: stopping.TrendRule = stopping.RULE) -> dict:
-    """The rows of every model recorded in `workdir` (a ``data_efficiency_full`` run) and their counts."""
-    rows = [audit_record(record, rule) for record in full_run.records(workdir).values()]
+    """The rows of every model recorded in `workdir` (a ``data_efficiency_full`` run), their counts and the
+    fixed-budget models' `continuations`."""
+    records = full_run.records(workdir)
+    rows = [audit_record(record, rule) for record in records.values()]
     met = [row for row in rows if row["criterion_met"]]
     counts = {
         "models": len(rows), "criterion_met": len(met),
@@ -52,7 +86,8 @@ def audit(workdir: str | Path, rule: stopping.TrendRule = stopping.RULE) -> dict
         "rule_too_short": sum(row["too_short"] for row in met),
         "rule_agrees": sum(row["rule_stops"] for row in met),
     }
-    return {"rule": dataclasses.asdict(rule), "workdir": str(workdir), "counts": counts, "rows": rows}
+    return {"rule": dataclasses.asdict(rule), "workdir": str(workdir), "counts": counts, "rows": rows,
+            "continuations": continuations(records, rule)}
 
 
 def markdown(results: Mapping) -> str:
@@ -85,6 +120,21 @@ def markdown(results: Mapping) -> str:
         first = "–" if row["first_stop"] is None else f"{row['first_stop']:,}"
         lines.append(f"| {row['key']} | {row['stopped_at']:,} | {'met' if row['criterion_met'] else 'budget'} | "
                      f"{end_gain} | {'yes' if row['improving'] else 'no'} | {gain} | {bounds} | {stops} | {first} |")
+    if results.get("continuations"):
+        lines += ["", "## Fixed budgets: the continuation rule", "",
+                  f"A variant's seeds continue to twice their steps when the rule stops none of them at its last "
+                  f"score (`pushjax.train.stopping.long_run_continues`: any seed's upper bound on the gain per "
+                  f"{rule['per_steps']} steps over the last {rule['window_steps']} at or above {rule['max_gain']} "
+                  f"points).", "",
+                  "| variant | size | seed | steps | gain, rule's window | its 95 % bounds | rule stops | the variant |",
+                  "|---|---:|---:|---:|---:|---|---|---|"]
+        for row in results["continuations"]:
+            verdict = f"continues to {row['next_steps']:,}" if row["continues"] else "stops"
+            for seed, steps, trend, stops in zip(row["seeds"], row["steps"], row["trends"], row["rule_stops"]):
+                gain = "–" if trend is None else f"{trend['gain']:+.2f} ± {trend['gain_se']:.2f}"
+                bounds = "–" if trend is None else f"[{trend['gain_lower']:+.2f}, {trend['gain_upper']:+.2f}]"
+                lines.append(f"| {row['variant']} | {row['size']:,} | {seed} | {steps:,} | {gain} | {bounds} | "
+                             f"{'yes' if stops else 'no'} | {verdict} |")
     return "\n".join(lines) + "\n"
 
 

@@ -10,14 +10,16 @@ from pushjax.paper import stopping_audit
 from tests.paper.conftest import run_binary
 
 
-def _record(key, scores, converged=True, decay=1_000):
+def _record(key, scores, converged=True, decay=1_000, fixed_budget=False):
     steps = [1_000 * (index + 1) for index in range(len(scores))]
     validation = [{"step": step, "trans_percent": score - 5.0, "rot_percent": score + 5.0}
                   for step, score in zip(steps, scores)]
-    validation.append({"step": steps[-1] + decay, "trans_percent": 0.0, "rot_percent": 0.0})  # after the decay
+    if decay:
+        validation.append({"step": steps[-1] + decay, "trans_percent": 0.0, "rot_percent": 0.0})  # after the decay
     variant, size, seed = key.rsplit("_", 2)
     return {"key": key, "row": {"model": variant, "train_size": int(size), "seed": int(seed[len("seed"):]),
-                                "constant_steps": steps[-1], "converged": converged}, "validation": validation}
+                                "constant_steps": steps[-1], "converged": converged, "steps": steps[-1] + decay},
+            "validation": validation, "criterion": {"stop_on_plateau": not fixed_budget}}
 
 
 def _write(folder, *records):
@@ -52,3 +54,27 @@ def test_the_binary_writes_the_audit_and_rejects_a_folder_without_records(tmp_pa
     assert json.loads((tmp_path / "out" / "results.json").read_text())["counts"]["models"] == 1
     with pytest.raises(app.UsageError, match="--run: no model records in"):
         run_binary("stopping_audit", f"--run={tmp_path / 'empty'}", f"--workdir={tmp_path / 'out'}")
+
+
+def test_fixed_budgets_continue_when_a_seed_still_falls_and_stop_when_none_does(tmp_path):
+    rng = np.random.default_rng(1)
+    flat = [30.0 + rng.normal(0, 0.1, 75) for _ in range(3)]
+    falling = 40.0 - 0.2 * np.arange(75) + rng.normal(0, 0.1, 75)  # 2 points per 10 000 steps
+    records = [_record(f"hybrid_190080_seed{seed}", curve, converged=False, decay=0, fixed_budget=True)
+               for seed, curve in enumerate(flat)]
+    records += [_record(f"neural_190080_seed{seed}", curve, converged=False, decay=0, fixed_budget=True)
+                for seed, curve in enumerate([flat[0], falling, flat[2]])]
+    records.append(_record("neural_100_seed0", flat[0]))  # the criterion's: not a fixed budget
+    _write(tmp_path / "run", *records)
+    results = stopping_audit.audit(tmp_path / "run")
+    rows = {row["variant"]: row for row in results["continuations"]}
+    assert set(rows) == {"hybrid", "neural"} and rows["neural"]["size"] == 190_080
+    assert rows["hybrid"]["rule_stops"] == [True, True, True] and not rows["hybrid"]["continues"]
+    assert rows["hybrid"]["next_steps"] is None
+    assert rows["neural"]["rule_stops"] == [True, False, True] and rows["neural"]["continues"]
+    assert rows["neural"]["next_steps"] == 150_000 and rows["neural"]["steps"] == [75_000] * 3
+    assert rows["neural"]["trends"][1]["gain"] == pytest.approx(2.0, abs=0.3)
+    run_binary("stopping_audit", f"--run={tmp_path / 'run'}", f"--workdir={tmp_path / 'out'}")
+    markdown = (tmp_path / "out" / "results.md").read_text()
+    assert "| neural | 190,080 | 1 | 75,000 |" in markdown and "| continues to 150,000 |" in markdown
+    assert "| hybrid | 190,080 | 0 | 75,000 |" in markdown and markdown.count("| stops |") == 3
