@@ -122,10 +122,10 @@ def markdown(results: Mapping) -> str:
                      f"{end_gain} | {'yes' if row['improving'] else 'no'} | {gain} | {bounds} | {stops} | {first} |")
     if results.get("continuations"):
         lines += ["", "## Fixed budgets: the continuation rule", "",
-                  f"A variant's seeds continue to twice their steps when the rule stops none of them at its last "
-                  f"score (`pushjax.train.stopping.long_run_continues`: any seed's upper bound on the gain per "
-                  f"{rule['per_steps']} steps over the last {rule['window_steps']} at or above {rule['max_gain']} "
-                  f"points).", "",
+                  f"A variant's recorded seeds continue to twice their steps unless the rule stops every one of "
+                  f"them at its last score (`pushjax.train.stopping.long_run_continues`: one seed's upper bound on "
+                  f"the gain per {rule['per_steps']} steps over the last {rule['window_steps']} at or above "
+                  f"{rule['max_gain']} points continues them all).", "",
                   "| variant | size | seed | steps | gain, rule's window | its 95 % bounds | rule stops | the variant |",
                   "|---|---:|---:|---:|---:|---|---|---|"]
         for row in results["continuations"]:
