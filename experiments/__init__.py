@@ -1,4 +1,5 @@
-"""The absl binaries of pushjax (``python -m experiments.<name>``): a few lines each, flags -> library call.
+"""The absl binaries of pushjax (``python -m experiments.<name>``): flags -> validation of their combinations -> one
+library call (the logic lives in ``pushjax``).
 
 Each starts with `run(main)` rather than ``app.run(main)``: every usage error, whether absl rejects a flag (a bad
 value, a failed validator, an unknown or missing flag), ``main`` raises ``app.UsageError`` (a bad combination of
