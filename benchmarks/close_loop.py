@@ -56,7 +56,7 @@ def main():
         workdir = args.workdir or Path(scratch) / "loop"
         start = time.perf_counter()
         settings = RecordingConfig(seed=args.seed, velocities=VELOCITIES, effects=Effects.parse(args.effects),
-                                     declare_effects=False, testbed=IDEAL)
+                                   declare_effects=False, testbed=IDEAL)
         recorded = record_pushes(data_dir, OBJECTS, SURFACES, args.pushes_per_pair, settings, workers=args.workers,
                                  progress=True)
         print(f"recorded {len(recorded.written)} pushes ({len(recorded.skipped)} reused) in "

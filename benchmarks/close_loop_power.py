@@ -109,7 +109,7 @@ def analyse(data_dir: Path, setup: str, case: str, seed: int, cached_only: bool 
     pushes = data_dir / case / f"seed{seed}"
     objects, surfaces, velocities, _ = SETUPS[setup]
     settings = RecordingConfig(seed=seed, velocities=velocities, effects=Effects.parse(effects),
-                                 declare_effects=False, support=support, testbed=IDEAL, start_poses=start_poses)
+                               declare_effects=False, support=support, testbed=IDEAL, start_poses=start_poses)
     record_pushes(pushes, objects, surfaces, PUSHES_PER_OBJECT, settings, workers=1, progress=False)
     start = time.perf_counter()
     examples = build_examples(iter_pushes(pushes))[0]

@@ -53,7 +53,7 @@ def main():
     with tempfile.TemporaryDirectory() as scratch:
         data_dir = args.data_dir or Path(scratch) / "pushes"
         settings = RecordingConfig(seed=args.seed, velocities=tuple(float(v) for v in args.velocities.split(",")),
-                                     declare_effects=False, testbed=IDEAL)
+                                   declare_effects=False, testbed=IDEAL)
         record_pushes(data_dir, objects, [args.surface], args.pushes, settings, workers=1, progress=True)
         examples, _ = build_examples(iter_pushes(data_dir), pusher_friction=scene.pusher_friction())
     inputs = examples.inputs

@@ -80,7 +80,7 @@ def record(tmp_path_factory):
     def get(name):
         root = shared / f"loop_pushes_{name}"
         settings = RecordingConfig(seed=1, velocities=(20.0,), effects=CASES[name].effects, declare_effects=False,
-                                     testbed=IDEAL)
+                                   testbed=IDEAL)
         return once_across_workers(root, lambda: record_pushes(root, ["rect1"], ["pu"], CASES[name].pushes, settings,
                                                                workers=1, progress=False))
 

@@ -51,7 +51,7 @@ def test_a_turning_object_whose_contact_sticks_is_not_read_as_sliding(tmp_path):
     # sticks; those samples lie inside the cone. Only the tip's slip over the object counts as sliding, so every
     # push that slid reads the simulated coefficient (the touched point's motion along the outline read 0.22-0.6).
     settings = RecordingConfig(seed=0, velocities=(40.0,), effects=Effects(pusher_friction=0.6),
-                                 declare_effects=False, testbed=IDEAL)
+                               declare_effects=False, testbed=IDEAL)
     record_pushes(tmp_path, ["ellip3"], ["delrin"], 12, settings, workers=1, progress=False)
     pushes = list(iter_pushes(tmp_path))
     values = np.array([force.sliding_friction(push, get_object("ellip3"), tracking_noise(push.object))[0]
