@@ -386,8 +386,8 @@ def sweep(
     step_fn = compiled_step(train_config.model, physics, optimizer_settings, train_config.weight_decay, mode,
                             options is not None, mesh)
     example_batch = gather(examples, batch_indices(specs[0], 0, train_config.batch_size), fields)
-    models = [create_train_state(model, make_optimizer(*optimizer_settings), example_batch, spec.seed)
-              for spec in specs]
+    optimizer = make_optimizer(*optimizer_settings)
+    models = [create_train_state(model, optimizer, example_batch, spec.seed) for spec in specs]
     if criterion is not None:
         models = [with_learning_rate(state, train_config.learning_rate) for state in models]
     files = _Files(workdir, model_metadata(train_config.model, specs), keep_checkpoints)
