@@ -1,7 +1,7 @@
 """How often does the loop select an effect on clean data, by the number of push sequences? The measurement
 behind ``pushjax.loop.splits.MIN_SEQUENCES`` (by hand; not a timed test).
 
-Clean data sets of the independent set-up of ``benchmarks/close_loop_power.py`` (ellip2 and tri1 on abs,
+Clean data sets of the independent set-up of ``benchmarks/close_loop_power.py`` of commit 1135d3f (ellip2 and tri1 on abs,
 10 and 30 mm/s, no effect; recorded there), subsampled to N push sequences (DRAWS seeded draws per N, from
 the five recorded data sets in turn), analysed by the loop's split and forward selection with its measured
 minimum switched off (the sign-flip test's own floor of 2^-S stays: below 12 sequences no effect can pass).

@@ -1,11 +1,11 @@
 """The loop's decision on part of a stored power-benchmark data set: the pushes of one speed, or a random half of the
 push sequences (by hand; not a timed test).
 
-Asks whether a selection on a data set that mixes push speeds (``benchmarks/close_loop_power.py --setup held_out``: 15
-and 40 mm/s) comes from mixing them: compare the decision on each speed alone with that on random halves of the same
+Asks whether a selection on a data set that mixes push speeds (``python -m experiments.loop_power --setup=held_out``: 15
+and 40 mm/s; its pushes in ``work/loop_power/held_out/<case>/seed<k>/pushes``) comes from mixing them: compare the decision on each speed alone with that on random halves of the same
 size that keep both speeds (the control for the lost power).
 
-    python benchmarks/close_loop_subsets.py --data work/bench/close_loop_power_v3/held_out/clean/seed0 --seed 0 \
+    python benchmarks/close_loop_subsets.py --data work/loop_power/held_out/clean/seed0/pushes --seed 0 \
         (--speed 15 | --half 1)
 """
 

@@ -28,7 +28,7 @@ HELP_TEXT = re.compile(r"^\s+--\[?\w|^flags:|^\s+\(default: |Try --help")
 LIBRARIES = ("experiments, pushjax.data, pushjax.loop, pushjax.paper.findings, pushjax.paper.figures, "
              "pushjax.paper.rollouts, pushjax.paper.runner, pushjax.paper.spec, pushjax.paper.tables, "
              "pushjax.paper.visualize, pushjax.physics.demo, pushjax.sim.dataset, pushjax.studies.push_to_goal, "
-             "pushjax.studies.adapt")
+             "pushjax.studies.adapt, pushjax.studies.loop_power")
 """What the binaries import, bar the binaries themselves (each defines flags): a server imports it once and forks."""
 
 # The server: imports the libraries (not the binaries, which define the flags), then forks one child per case.
@@ -291,6 +291,13 @@ CASES = [
                            ("max_time", ("0", "nan")), ("seed", ("-1",)))
       for value in values],
     ("adapt", ["--workdir={tmp}/adapt", "extra"], "unexpected arguments"),
+    # loop_power
+    ("loop_power", ["--archive={file}/archive", "--cached_only"], "--archive"),
+    *[("loop_power", ["--archive={tmp}/archive", f"--{flag}={value}", "--cached_only"], f"--{flag}")
+      for flag, values in (("setup", ("moon",)), ("cases", ("wind", "", "clean,wind")), ("seeds", ("0", "x")),
+                           ("clean_seeds", ("-1",)))
+      for value in values],
+    ("loop_power", ["--archive={tmp}/archive", "extra"], "unexpected arguments"),
     # demo
     *[("demo", [f"--{flag}={value}"], f"--{flag}")
       for flag, values in (("mu", ("-1", "nan", "inf")), ("angle_deg", ("90", "-120", "nan")),

@@ -30,8 +30,8 @@ MIN_TEST_SEQUENCES = 4
 """Fewest sequences in the test split: fewer give no usable interval of the reported error."""
 CROSS_FIT_BELOW = 100
 """A single select split needs at least this many sequences; below, the pool is cross-fitted (every pool sequence
-selects, so the test sees three times the sequences of a 25 % select split). Measured (``python
-benchmarks/close_loop_power.py --start_poses scattered``, BENCHMARKS.md): at 200 pushes a single split of 50 select
+selects, so the test sees three times the sequences of a 25 % select split). Measured (``benchmarks/close_loop_power.py
+--start_poses scattered`` of commit 1135d3f, BENCHMARKS.md): at 200 pushes a single split of 50 select
 sequences accepted a centre-of-mass offset adding 22 % to the error in 2 of 5 data sets, cross-fitting in 5 of 5,
 with the level kept on a sign-flipped null (both scripts as of commit 1135d3f); 100 is twice the size measured short."""
 CROSS_FIT_FOLDS = 4
