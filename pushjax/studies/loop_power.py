@@ -123,6 +123,12 @@ CASES = {
 convex hull's corners) and ``ring`` (16 supports along the outline, a dished base on its edge)."""
 CLEAN = ("clean", "clean_feet", "clean_ring", "clean_scattered")
 REAL_DIFFERENCES = frozenset({"limit_surface", "inertia"})
+TESTBED_LEADING_EDGE = "leading_edge"
+"""The load's shift towards the leading edge (``mu * thickness / 2``) is in every simulation of the testbed
+(RESULTS.md, "Closing the loop on realistic data") and counts as a false discovery under the committed criteria,
+which list only :data:`REAL_DIFFERENCES`. Stated after the fresh set-up's first analysis (clean seed 0 selected
+``leading_edge`` beside ``limit_surface``), not part of its goal: the tables also count the clean data sets with
+anything selected beyond the real differences and ``leading_edge``, a second look, labelled as such."""
 RIGHT_FIRST = {"com_offset": {"cof_offset", "pressure_gradient"}, "table_tilt": {"table_tilt"}}
 SENSOR_TOLERANCE = 0.1
 """Largest relative error of the force sensor's pusher friction that counts as found."""
@@ -229,9 +235,9 @@ def archived(folder: str | Path) -> dict:
     return {key: json.loads((folder / f"{key}.json").read_text()) for key in ("analysis", "report", "details")}
 
 
-def false_discoveries(outcome: Mapping) -> list[str]:
-    """The effects selected beyond the real differences, in the order selected."""
-    return [name for name in outcome["report"]["selected"] if name not in REAL_DIFFERENCES]
+def false_discoveries(outcome: Mapping, also_real: frozenset[str] = frozenset()) -> list[str]:
+    """The effects selected beyond the real differences (and ``also_real``), in the order selected."""
+    return [name for name in outcome["report"]["selected"] if name not in REAL_DIFFERENCES | also_real]
 
 
 def plain_score(outcome: Mapping) -> float:
@@ -290,7 +296,7 @@ def judge(setup: str, outcomes: Mapping[str, Sequence[Mapping]]) -> dict:
     chosen = SETUPS[setup]
     clean = [plain_score(outcome) for outcome in outcomes.get("clean", [])]
     reference = float(np.mean(clean)) if clean else math.nan
-    rows, met, wrong, clean_total = [], True, 0, 0
+    rows, met, wrong, wrong_leading_edge, clean_total = [], True, 0, 0, 0
     for case in chosen.cases:
         results = outcomes.get(case, [])
         if not results:
@@ -299,18 +305,21 @@ def judge(setup: str, outcomes: Mapping[str, Sequence[Mapping]]) -> dict:
         scores = [plain_score(outcome) for outcome in results]
         hits = [found(outcome) for outcome in results]
         beyond = sum(bool(false_discoveries(outcome)) for outcome in results)
+        beyond_leading_edge = sum(bool(false_discoveries(outcome, frozenset({TESTBED_LEADING_EDGE})))
+                                  for outcome in results)
         added = float(np.mean(scores)) / reference - 1
         power = None if case in CLEAN else float(np.mean(hits))
         rows.append({"case": case, "support": kind.support, "effects": kind.effects, "testbed": kind.testbed,
                      "start_poses": kind.start_poses, "data_sets": len(results), "seeds": [
                          outcome["analysis"]["seed"] for outcome in results],
                      "plain_score": float(np.mean(scores)), "added_error": added, "power": power,
-                     "beyond_real_differences": beyond, "selections": [_listing(outcome) for outcome in results],
+                     "beyond_real_differences": beyond, "beyond_leading_edge": beyond_leading_edge, "selections": [_listing(outcome) for outcome in results],
                      "in_goal": case in chosen.goal_cases})
         if case not in chosen.goal_cases:
             continue
         if case in CLEAN:
             wrong += beyond
+            wrong_leading_edge += beyond_leading_edge
             clean_total += len(results)
         elif kind.family == "variability" or added >= ADDED_ERROR_FOR_GOAL:
             met &= power >= POWER_GOAL
@@ -325,6 +334,7 @@ def judge(setup: str, outcomes: Mapping[str, Sequence[Mapping]]) -> dict:
     complete = all(outcomes.get(case) for case in chosen.goal_cases) and not missing
     return {"setup": setup, "rows": rows, "false_discoveries": wrong, "clean_data_sets": clean_total,
             "false_discovery_rate": rate, "false_discovery_upper_bound": bound,
+            "beyond_leading_edge": wrong_leading_edge,
             "goal_met": bool(met) if complete else None,
             "complete": complete, "missing": missing, "criteria": CRITERIA if setup in PLANS else None}
 
@@ -377,18 +387,24 @@ def write(results: Mapping, table: str, archive: str | Path) -> list[Path]:
 def markdown(results: Mapping) -> str:
     """The table of :func:`judge`'s results."""
     lines = ["| case | support | testbed effect | start poses | plain model, test % | added error | data sets | found | "
-             "anything beyond limit_surface, inertia | selections |", "|---|---|---|---|---:|---:|---:|---:|---:|---|"]
+             "anything beyond limit_surface, inertia | ... and leading_edge | selections |",
+             "|---|---|---|---|---:|---:|---:|---:|---:|---:|---|"]
     for row in results["rows"]:
         effect = "; ".join(part for part in (row["effects"], row["testbed"]) if part) or "-"
         power = "-" if row["power"] is None else f"{row['power']:.0%}"
         lines.append(f"| {row['case']}{'' if row['in_goal'] else ' (beside the goal)'} | {row['support']} | {effect} | "
                      f"{row['start_poses']} | {row['plain_score']:.1f} | {row['added_error']:+.0%} | "
-                     f"{row['data_sets']} | {power} | {row['beyond_real_differences']} | "
+                     f"{row['data_sets']} | {power} | {row['beyond_real_differences']} | {row['beyond_leading_edge']} | "
                      f"{'; '.join(row['selections'])} |")
     total = results["clean_data_sets"]
     lines += ["", f"False discoveries on the goal's clean data sets: {results['false_discoveries']} of {total}"
               + (f" ({results['false_discovery_rate']:.1%}; one-sided 95 % upper bound "
                  f"{results['false_discovery_upper_bound']:.1%})" if total else "") + "."]
+    if total:
+        beyond = results["beyond_leading_edge"]
+        lines.append(f"Second look, stated after the first analysis and not the goal's criterion (`leading_edge` is in "
+                     f"every simulation): {beyond} of {total} with anything selected beyond limit_surface, inertia and "
+                     f"leading_edge (one-sided 95 % upper bound {upper_bound(beyond, total):.1%}).")
     if results["complete"]:
         lines.append(f"Goal: **{'met' if results['goal_met'] else 'not met'}**.")
     else:

@@ -96,6 +96,14 @@ def test_two_false_discoveries_in_sixty_fail_the_bound_and_one_does_not():
     assert results["goal_met"] is False
 
 
+def test_leading_edge_is_a_false_discovery_by_the_criteria_and_counted_apart_in_the_second_look():
+    outcomes = _planned(clean=(0, {"selected": ("leading_edge", "limit_surface")}),
+                        clean_ring=(1, {"selected": ("leading_edge", "friction_field")}))
+    results = loop_power.judge("fresh", outcomes)
+    assert results["false_discoveries"] == 2 and results["beyond_leading_edge"] == 1
+    assert results["goal_met"] is False
+
+
 def test_a_missed_effect_fails_the_goal_only_where_it_adds_enough_error():
     missed = {"selected": ("limit_surface",), "baseline": (30.0, 40.0)}
     assert loop_power.judge("fresh", _planned(table_tilt_s=(0, missed)))["goal_met"] is False  # 5 of 6: 83 %
