@@ -7,7 +7,7 @@
 # 1. neural, hybrid and error at the full split, seeds 0-2, the paper's 75 000 steps (convergence.PAPER_SCHEDULE);
 # 2. the continuation rule (pushjax.train.stopping.long_run_continues, committed before the run) on every variant's
 #    three seeds at 75 000 steps (experiments.stopping_audit -> results/data_efficiency_long/continuation/), the
-#    variants it continues kept in continuation/continued_to_150000.txt so that a rerun does not decide again;
+#    decision kept per variant in continuation/<variant>.txt so that a rerun does not decide again;
 # 3. those variants trained on to 150 000 steps, and the rule's record written again;
 # 4. the Table 1 findings decided with the long-trained models beside the criterion's
 #    (experiments.findings --replace_with), written to results/data_efficiency_long/findings.md.
@@ -29,20 +29,26 @@ audit() {
 }
 
 train --variants=neural,hybrid,error
-decision="$RUN/continuation/continued_to_150000.txt"
-if [ ! -f "$decision" ]; then  # decided once, on the nine models at 75 000 steps, and kept for the reruns
-  audit
-  "$PYTHON" - "$RUN/continuation/results.json" > "$decision.partial" <<'EOF'
+# Each variant is decided once, on its three seeds at 75 000 steps, and the decision kept for the reruns (a variant
+# continued beside another still at 75 000 is not decided again on its longer records).
+continued=""
+for variant in neural hybrid error; do
+  decision="$RUN/continuation/$variant.txt"
+  if [ ! -f "$decision" ]; then
+    audit
+    if "$PYTHON" - "$RUN/continuation/results.json" "$variant" > "$decision.partial" <<'EOF'
 import json, sys
-rows = json.load(open(sys.argv[1]))["continuations"]
-print(",".join(row["variant"] for row in rows if row["continues"] and row["variant"] in ("neural", "hybrid", "error")
-               and row["steps"] == [75000, 75000, 75000]))
+rows = [row for row in json.load(open(sys.argv[1]))["continuations"] if row["variant"] == sys.argv[2]]
+if len(rows) != 1 or rows[0]["steps"] != [75000, 75000, 75000]:
+    sys.exit(3)  # not three seeds at 75 000 steps: undecided
+print("continues to 150000" if rows[0]["continues"] else "stops at 75000")
 EOF
-  mv "$decision.partial" "$decision"
-fi
-continued=$(cat "$decision")
+    then mv "$decision.partial" "$decision"; else rm -f "$decision.partial"; echo "$variant: undecided"; continue; fi
+  fi
+  if grep -q continues "$decision"; then continued="${continued:+$continued,}$variant"; fi
+done
 if [ -n "$continued" ]; then
-  echo "the continuation rule continues $continued to 150 000 steps ($decision)"
+  echo "the continuation rule continues $continued to 150 000 steps ($RUN/continuation/)"
   train --steps=150000 --variants="$continued"
 fi
 audit
