@@ -50,6 +50,10 @@ def test_a_real_difference_is_no_false_discovery_and_anything_else_is():
     ("variability_s", {"drawn": 0.20, "recovered": 0.24}, True),
     ("variability_s", {"drawn": 0.20, "recovered": 0.26}, False),
     ("variability_l", {"drawn": 0.40, "recovered": None}, False),
+    ("anisotropy", {"selected": ("anisotropic_friction", "frame_offset")}, True),
+    ("tracking_bias", {"selected": ("frame_offset",)}, True),
+    ("tracking_yaw_bias", {"selected": ("limit_surface",)}, True),  # outside the library: nothing beyond is right
+    ("tracking_yaw_bias", {"selected": ("frame_offset",)}, False),
 ])
 def test_found_follows_the_stated_criteria(case, kwargs, expected):
     assert loop_power.found(_outcome(case, **kwargs)) is expected
@@ -114,6 +118,23 @@ def test_a_missed_effect_fails_the_goal_only_where_it_adds_enough_error():
     assert loop_power.judge("fresh", weak)["goal_met"] is True
     spread = _planned(variability_l=(2, {"drawn": 0.4, "recovered": 0.2}))  # variability counts whatever it adds
     assert loop_power.judge("fresh", spread)["goal_met"] is False
+
+
+def test_the_library_set_up_has_no_goal_and_a_row_per_analysis():
+    outcomes = {}
+    for case in loop_power.SETUPS["library"].cases:
+        outcome = _outcome(case, baseline=(30.0, 50.0))
+        outcome["report"] |= {"after": {"trans_percent": 10.0, "rot_percent": 10.0}, "explained": False,
+                              "noise_floor": {"trans_percent": 0.0, "rot_percent": 0.0},
+                              "fallback": {"trans_percent": 12.0, "rot_percent": 8.0}}
+        outcome["analysis"]["case"] = case
+        outcomes[case] = [outcome]
+    results = loop_power.judge("library", outcomes)
+    assert results["complete"] and results["goal_met"] is None
+    assert [row["case"] for row in results["analyses"]] == list(loop_power.SETUPS["library"].cases)
+    table = loop_power.markdown(results)
+    assert "| tracking_yaw_bias | 0 | 80.0 | 20.0 | 75% | limit_surface | 0.0 | False | 20.0 | True |" in table
+    assert "Goal" not in table and "beside the goal" not in table
 
 
 def test_the_committed_tables_are_rebuilt_from_the_archive():
