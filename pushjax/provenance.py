@@ -73,3 +73,43 @@ def write_source_diff(workdir: str | os.PathLike, state: dict | None) -> dict:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(state["diff"])
     return {"commit": state["commit"] + "+changes", "source_diff": relative}
+
+
+DATA_FILE_PATTERN = "*.array_record-*"
+"""The data files of a built dataset (TFDS's ``array_record`` shards): what a model trained on and was scored on."""
+
+
+def file_digests(folder: str | os.PathLike, pattern: str = DATA_FILE_PATTERN) -> dict[str, str]:
+    """{file name: sha256 hex digest} of the files of `folder` matching `pattern`, sorted by name."""
+    digests = {}
+    for path in sorted(Path(folder).glob(pattern)):
+        digest = hashlib.sha256()
+        with path.open("rb") as file:
+            for block in iter(lambda: file.read(1 << 20), b""):
+                digest.update(block)
+        digests[path.name] = digest.hexdigest()
+    return digests
+
+
+def digests_text(digests: dict[str, str]) -> str:
+    """`file_digests` in ``sha256sum``'s format (``<digest>  <name>`` a line), which ``sha256sum -c`` checks."""
+    return "".join(f"{digest}  {name}\n" for name, digest in digests.items())
+
+
+def parse_digests(text: str) -> dict[str, str]:
+    """The {file name: digest} of a ``sha256sum``-format text (`digests_text`)."""
+    return {name: digest for digest, _, name in (line.partition("  ") for line in text.splitlines() if line.strip())}
+
+
+def tree_digest(tree) -> str:
+    """sha256 hex digest of a pytree of arrays (e.g. a model's parameters): every leaf's path, dtype, shape and bytes
+    in the order of its flattening, so that two trees have one digest exactly when they are bit-identical."""
+    import jax  # only here: reading and tabulating results imports this module and must not load JAX
+    import numpy as np
+
+    digest = hashlib.sha256()
+    for path, leaf in jax.tree_util.tree_flatten_with_path(tree)[0]:
+        value = np.ascontiguousarray(np.asarray(leaf))
+        digest.update(f"{jax.tree_util.keystr(path)}:{value.dtype.str}:{value.shape};".encode())
+        digest.update(value.tobytes())
+    return digest.hexdigest()

@@ -22,7 +22,9 @@ model interrupted before its record is written continues from its training state
 removed once the record is written, kept under a fixed budget to be continued further), to the same
 parameters and record as without the interruption. Commit that folder with the records when a sitting ends (a few
 hundred KiB per model, a few MiB for the wide ones) and a fresh checkout continues those models too. The dataset is rebuilt from its
-seed when missing. Each trained model's parameters go to ``<workdir>/checkpoints/<key>/`` (not committed), from which
+seed when missing; the digests of the build the baselines were scored on are kept in ``<workdir>/dataset.sha256``, a run
+on another build (a rebuild on other hardware may differ in its last bits) says so, and every record names its build
+(``dataset_sha256``) and the digest of its final parameters (``params_sha256``). Each trained model's parameters go to ``<workdir>/checkpoints/<key>/`` (not committed), from which
 ``pushjax.load_model(workdir, model=key)`` loads it to predict; models recorded before the run kept them have none.
 """
 
@@ -30,6 +32,7 @@ from __future__ import annotations
 
 import dataclasses
 import datetime
+import hashlib
 import json
 import shutil
 import threading
@@ -60,6 +63,9 @@ CHECKPOINTS = "checkpoints"
 """The work directory's folder of one checkpoint folder per trained model (named by its key)."""
 IN_TRAINING = "in_training"
 """The work directory's folder of the training state of each model being trained (named by its key)."""
+DATASET_DIGESTS = "dataset.sha256"
+"""The work directory's record of the dataset build its baselines were scored on: the sha256 of every data file
+(``sha256sum`` format, `pushjax.provenance.file_digests`), written with ``baselines.json``."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -198,8 +204,10 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Traini
     `checkpoint_dir`, its parameters go to a checkpoint there (`pushjax.train.predictor.save_model`, replacing any
     earlier one); with `resume_dir`, it trains in that work directory of the trainer (its training state saved at
     every score, ``metrics.csv`` every score, TensorBoard) and a later call continues from it. `provenance` is the
-    code's commit (and the diff of changed code, `pushjax.provenance.write_source_diff`) as the run started; None:
-    the checkout's commit now."""
+    code's commit (and the diff of changed code, `pushjax.provenance.write_source_diff`) as the run started, and the
+    dataset build's ``dataset_sha256`` (`check_dataset`); None: the checkout's commit now. The record's
+    ``params_sha256`` is the digest of the model's final variables (`pushjax.provenance.tree_digest`), so that a
+    retraining can be checked bit-identical without the checkpoint."""
     model_spec = train_examples.model_spec(unit)
     size = len(model_spec.train_indices)
     config = dataclasses.replace(train_config(spec, unit), log_every=criterion.eval_every)
@@ -226,10 +234,27 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Traini
         "parameters": int(sum(np.size(leaf) for leaf in jax.tree.leaves(state.params))),
         "train_seconds": round(phases.seconds, 1), "eval_seconds": round(time.monotonic() - clock, 1),
         "steps_per_second": phases.steps_per_second, "started": started.isoformat(timespec="seconds"),
-        "device": device_description(),
+        "device": device_description(), "params_sha256": provenance_lib.tree_digest(train_lib.predictor.checkpoint_variables(state)),
         **(provenance if provenance is not None else
            ({"commit": commit} if (commit := provenance_lib.git_commit()) else {})),
     })
+
+
+def check_dataset(workdir: Path, digests: Mapping[str, str], log: Callable[[str], None]) -> str:
+    """Compares the dataset build being read (`digests`, `pushjax.provenance.file_digests`) with the one the run's
+    baselines were scored on (`DATASET_DIGESTS`, written here on a run's first call), logs a line where they differ,
+    and returns the build's digest (the sha256 of its `DATASET_DIGESTS` text), which every record names."""
+    text = provenance_lib.digests_text(digests)
+    path = workdir / DATASET_DIGESTS
+    if not path.exists():
+        path.write_text(text)
+    recorded = provenance_lib.parse_digests(path.read_text())
+    differing = sorted(name for name in set(recorded) | set(digests) if recorded.get(name) != digests.get(name))
+    if differing:
+        log(f"{NAME}: the dataset build read here differs from the one the baselines were scored on ({path}) in "
+            f"{len(differing)} of {len(set(recorded) | set(digests))} data files ({', '.join(differing[:3])}"
+            f"{', …' if len(differing) > 3 else ''}); each record names its build by dataset_sha256")
+    return hashlib.sha256(text.encode()).hexdigest()
 
 
 def device_description() -> dict:
@@ -300,6 +325,7 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
     test = train_lib.examples_from_source(splits["test"], fields)
     if not (workdir / "baselines.json").exists():
         _write_json(workdir / "baselines.json", outputs.compact(baseline_rows(spec, test)))
+    dataset = check_dataset(workdir, provenance_lib.file_digests(runner.dataset_folder(spec, spec.dataset)), log)
     done = records(workdir)
     todo = [unit for unit in units if needs_training(unit, done, criterion, len(splits["train"]))]
     provenance = provenance_lib.write_source_diff(workdir, provenance_lib.source_state())  # the code this process runs
@@ -321,7 +347,7 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
                     record = train_unit(spec, unit, train_examples, validation, test, criterion,
                                         lambda line, key=unit.key: log(f"[{key}] {line}"),
                                         workdir / CHECKPOINTS / unit.key, workdir / IN_TRAINING / unit.key,
-                                        provenance)
+                                        {**provenance, "dataset_sha256": dataset})
                 except BaseException:
                     queue.stop()  # no thread starts another model
                     raise

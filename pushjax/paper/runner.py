@@ -118,12 +118,7 @@ def load_splits(spec: ExperimentSpec, dataset: data.DatasetConfig, progress: boo
     another version).
     """
     identity = dict(seed=dataset.seed, testbed=dataset.testbed, min_test_sequences=dataset.min_test_sequences)
-    try:
-        builder = data.PushEffects(config=data.config_name(dataset.experiment, dataset.scale, dataset.testbed),
-                                   data_dir=spec.data_dir, seed=dataset.seed,
-                                   min_test_sequences=dataset.min_test_sequences)
-    except data.builder.DatasetFolderError as error:
-        raise DatasetUnavailableError(str(error)) from None
+    builder = _builder(spec, dataset)
     if not builder.is_prepared():
         name = data.dataset_name(dataset.experiment, dataset.scale, **identity)
         if not spec.build:
@@ -140,6 +135,19 @@ def load_splits(spec: ExperimentSpec, dataset: data.DatasetConfig, progress: boo
                    **identity)
     train_lib.distributed.wait_for_all(f"dataset {builder.builder_config.name} ready")
     return data.load(dataset.experiment, dataset.scale, data_dir=spec.data_dir, **identity)
+
+
+def dataset_folder(spec: ExperimentSpec, dataset: data.DatasetConfig) -> Path:
+    """The folder `load_splits` reads `dataset` from (its data files, `pushjax.provenance.file_digests`)."""
+    return Path(_builder(spec, dataset).data_dir)
+
+
+def _builder(spec: ExperimentSpec, dataset: data.DatasetConfig) -> data.PushEffects:
+    try:
+        return data.PushEffects(config=data.config_name(dataset.experiment, dataset.scale, dataset.testbed),
+                                data_dir=spec.data_dir, seed=dataset.seed, min_test_sequences=dataset.min_test_sequences)
+    except data.builder.DatasetFolderError as error:
+        raise DatasetUnavailableError(str(error)) from None
 
 
 def _split_sources(splits: Mapping, names: Sequence[str], dataset: data.DatasetConfig) -> list:

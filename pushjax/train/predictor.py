@@ -170,11 +170,16 @@ def find_checkpoints(path: str | os.PathLike) -> Path:
     return found[0]
 
 
+def checkpoint_variables(state: TrainState) -> dict:
+    """The variables of one model that `save_model` writes: its parameters and, where it has them, batch statistics."""
+    return {"params": state.params, **({"batch_stats": state.batch_stats} if state.batch_stats else {})}
+
+
 def save_model(folder: str | os.PathLike, step: int, model_config: ModelConfig, spec: ModelSpec,
                state: TrainState) -> None:
     """Writes one trained model as a checkpoint that `load_model` reads: its parameters and batch statistics (a model
     axis of one, as in a sweep's checkpoint) at `step` in `folder`, with `model_metadata` beside them."""
-    variables = {"params": state.params, **({"batch_stats": state.batch_stats} if state.batch_stats else {})}
+    variables = checkpoint_variables(state)
     checkpointer = Checkpointer(folder)
     try:
         checkpointer.save(step, jax.tree.map(lambda leaf: np.asarray(leaf)[None], variables),

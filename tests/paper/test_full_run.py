@@ -1,6 +1,7 @@
 """The paper-composition run (issue 30) on the smoke data: one model per unit, records, resuming."""
 
 import datetime
+import hashlib
 import json
 import shutil
 import types
@@ -9,11 +10,11 @@ import numpy as np
 import pytest
 from absl import app
 
-from pushjax import train as train_lib
+from pushjax import provenance, train as train_lib
 from pushjax.paper import findings, full_run, runner
 from pushjax.train import evaluate
 from pushjax.train.batching import batch_indices, gather
-from pushjax.train.predictor import load_model
+from pushjax.train.predictor import checkpoint_variables, load_model
 from tests.paper.conftest import RUNS, SMOKE, run_binary
 
 
@@ -53,6 +54,13 @@ def test_results_of_the_records(smoke_results):
     assert len(results["curves"]) == 3 * len(trained)  # steps 5, 10 and after the decay
     markdown = (workdir / "results.md").read_text()
     assert "## Convergence: criterion met per model" in markdown and "0/1 met, 12 steps" in markdown
+    # The build the baselines were scored on, and every record naming its build and its final parameters.
+    build = provenance.parse_digests((workdir / full_run.DATASET_DIGESTS).read_text())
+    assert len(build) >= 2 and all(len(digest) == 64 for digest in build.values())
+    built = hashlib.sha256((workdir / full_run.DATASET_DIGESTS).read_bytes()).hexdigest()
+    saved = [json.loads(path.read_text()) for path in (workdir / "models").iterdir()]
+    assert {record["dataset_sha256"] for record in saved} == {built}
+    assert len({record["params_sha256"] for record in saved}) == len(saved)
     keys = {finding.key: finding for finding in findings.check(findings.load([workdir]))}
     assert keys["crossover"].experiment == "data_efficiency_full"
 
@@ -81,8 +89,22 @@ def test_a_fresh_checkout_trains_only_the_missing_models(smoke_results, smoke_da
     for key in missing:
         retrained, original = (json.loads(texts[f"{key}.json"]) for texts in (after, before))
         assert retrained["row"] == original["row"] and retrained["validation"] == original["validation"]
+        assert retrained["params_sha256"] == original["params_sha256"]  # bit-identical parameters
     assert json.loads((workdir / "results.json").read_text())["progress"]["done"] == 8
     assert not any((workdir / full_run.IN_TRAINING).iterdir())  # the training state goes with the record
+
+
+def test_a_run_on_another_build_of_its_dataset_says_so(tmp_path):
+    lines = []
+    digests = {"a.array_record-00000-of-00002": "0" * 64, "a.array_record-00001-of-00002": "1" * 64}
+    first = full_run.check_dataset(tmp_path, digests, lines.append)
+    assert lines == [] and provenance.parse_digests((tmp_path / full_run.DATASET_DIGESTS).read_text()) == digests
+    assert full_run.check_dataset(tmp_path, dict(digests), lines.append) == first and lines == []
+    other = {**digests, "a.array_record-00001-of-00002": "2" * 64}
+    assert full_run.check_dataset(tmp_path, other, lines.append) != first
+    assert len(lines) == 1 and "differs from the one the baselines were scored on" in lines[0]
+    assert "in 1 of 2 data files (a.array_record-00001-of-00002)" in lines[0]
+    assert provenance.parse_digests((tmp_path / full_run.DATASET_DIGESTS).read_text()) == digests  # kept
 
 
 def test_models_read_only_their_rows_and_see_the_batches_of_the_whole_split():
@@ -136,6 +158,7 @@ def test_a_recorded_model_loads_from_the_run_and_scores_as_recorded(smoke_result
     spec = full_run.make_spec(smoke_data("data_efficiency"), sizes=(40, 80), seeds=(0,), scale="smoke", build=False)
     test = train_lib.examples_from_source(runner.load_splits(spec, spec.dataset, False)["test"], spec.example_fields())
     state = types.SimpleNamespace(params=predictor.variables["params"], batch_stats=predictor.variables["batch_stats"])
+    assert provenance.tree_digest(checkpoint_variables(state)) == record["params_sha256"]
     scores = evaluate.evaluate(predictor.model, state, test)
     for key in ("trans_percent", "rot_percent"):
         assert scores[key] == pytest.approx(record["row"][key], rel=1e-5)

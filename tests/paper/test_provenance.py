@@ -2,6 +2,7 @@
 
 import subprocess
 
+import numpy as np
 import pytest
 
 from pushjax import provenance
@@ -56,3 +57,34 @@ def test_results_do_not_dirty_the_code_and_changed_code_is_kept(checkout, tmp_pa
 def test_no_checkout_no_provenance(tmp_path):
     assert provenance.source_state(tmp_path) is None and provenance.git_commit(tmp_path) is None
     assert provenance.write_source_diff(tmp_path, None) == {}
+
+
+def test_file_digests_are_sha256sums_and_read_back(tmp_path):
+    (tmp_path / "push_effects-train.array_record-00000-of-00002").write_bytes(b"abc")
+    (tmp_path / "push_effects-test.array_record-00000-of-00001").write_bytes(b"")
+    (tmp_path / "dataset_info.json").write_text("{}")  # not a data file
+    digests = provenance.file_digests(tmp_path)
+    assert list(digests) == ["push_effects-test.array_record-00000-of-00001",
+                             "push_effects-train.array_record-00000-of-00002"]
+    assert digests["push_effects-train.array_record-00000-of-00002"] == (
+        "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad")  # sha256("abc")
+    text = provenance.digests_text(digests)
+    assert provenance.parse_digests(text) == digests
+    check = subprocess.run(["sha256sum", "-c", "-"], input=text, cwd=tmp_path, capture_output=True, text=True)
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+def test_a_tree_digest_changes_with_any_bit_name_dtype_or_shape():
+    tree = {"dense": {"kernel": np.arange(6, dtype=np.float32).reshape(2, 3), "bias": np.zeros(3, np.float32)}}
+    digest = provenance.tree_digest(tree)
+    assert digest == provenance.tree_digest({"dense": {"bias": np.zeros(3, np.float32),
+                                                      "kernel": np.arange(6, dtype=np.float32).reshape(2, 3)}})
+    flipped = tree["dense"]["kernel"].copy()
+    flipped.view(np.uint32)[0, 0] ^= 1  # the last bit of one value
+    changed = [
+        {"dense": {**tree["dense"], "kernel": flipped}},
+        {"dense": {**tree["dense"], "kernel": tree["dense"]["kernel"].reshape(3, 2)}},
+        {"dense": {**tree["dense"], "bias": np.zeros(3, np.float64)}},
+        {"other": tree["dense"]},
+    ]
+    assert len({digest, *(provenance.tree_digest(other) for other in changed)}) == 1 + len(changed)
