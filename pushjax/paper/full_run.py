@@ -242,12 +242,15 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Traini
 
 def check_dataset(workdir: Path, digests: Mapping[str, str], log: Callable[[str], None]) -> str:
     """Compares the dataset build being read (`digests`, `pushjax.provenance.file_digests`) with the one the run's
-    baselines were scored on (`DATASET_DIGESTS`, written here on a run's first call), logs a line where they differ,
-    and returns the build's digest (the sha256 of its `DATASET_DIGESTS` text), which every record names."""
+    baselines were scored on (`DATASET_DIGESTS`, written with ``baselines.json``; a run whose baselines predate it has
+    none, and this says so), logs a line where they differ, and returns the build's digest (the sha256 of its
+    `DATASET_DIGESTS` text), which every record names."""
     text = provenance_lib.digests_text(digests)
     path = workdir / DATASET_DIGESTS
     if not path.exists():
-        path.write_text(text)
+        log(f"{NAME}: {path} is missing (baselines scored before builds were recorded), so this build "
+            f"({len(digests)} data files) cannot be compared with theirs; each record names its build by dataset_sha256")
+        return hashlib.sha256(text.encode()).hexdigest()
     recorded = provenance_lib.parse_digests(path.read_text())
     differing = sorted(name for name in set(recorded) | set(digests) if recorded.get(name) != digests.get(name))
     if differing:
@@ -323,9 +326,11 @@ def run(spec: spec_lib.ExperimentSpec, workdir: str | Path, units: Sequence[Unit
     fields = spec.example_fields()
     splits = runner.load_splits(spec, spec.dataset, progress)
     test = train_lib.examples_from_source(splits["test"], fields)
+    digests = provenance_lib.file_digests(runner.dataset_folder(spec, spec.dataset))
     if not (workdir / "baselines.json").exists():
         _write_json(workdir / "baselines.json", outputs.compact(baseline_rows(spec, test)))
-    dataset = check_dataset(workdir, provenance_lib.file_digests(runner.dataset_folder(spec, spec.dataset)), log)
+        (workdir / DATASET_DIGESTS).write_text(provenance_lib.digests_text(digests))
+    dataset = check_dataset(workdir, digests, log)
     done = records(workdir)
     todo = [unit for unit in units if needs_training(unit, done, criterion, len(splits["train"]))]
     provenance = provenance_lib.write_source_diff(workdir, provenance_lib.source_state())  # the code this process runs
