@@ -5,11 +5,12 @@ r"""Learn while pushing: the controller closes the loop on the pushes it makes, 
       [--seed=0]
 
 A testbed table with an effect the controller's model does not declare (its magnitude drawn per world seed), and a
-sequence of goals pushed three ways on the same goals: ``adaptive`` (the loop, ``pushjax.loop.close_loop``, runs on all
+sequence of goals pushed four ways on the same goals: ``adaptive`` (the loop, ``pushjax.loop.close_loop``, runs on all
 the controller's own recorded pushes after the first ``--first_block`` episodes and every ``--per_block`` after them,
-and the next block plans with the model it selected), ``plain`` (Lynch throughout) and ``oracle`` (the true effect and
-magnitude); see :mod:`pushjax.studies.adapt`. Writes ``results.json`` (rows per arm and block: success, time to goal,
-path length; what the loop selected after each block; the comparison rule's verdict), ``results.md`` and
+and the next block plans with the model it selected), ``plain`` (Lynch throughout), ``oracle`` (the true effect and
+magnitude) and ``filtered`` (Lynch whose pusher friction follows the EKF's within each episode); see
+:mod:`pushjax.studies.adapt`. Writes ``results.json`` (rows per arm and block: success, time to goal, path length; what
+the loop selected after each block; the comparison rules' verdicts), ``results.md`` and
 ``time_to_goal.png`` to ``--workdir``, the push files, the loop's reports and the finished episodes below it; a run
 over the same ``--workdir`` reads back what an earlier (interrupted) run finished instead of simulating it again.
 """

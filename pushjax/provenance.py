@@ -10,7 +10,10 @@ from __future__ import annotations
 import hashlib
 import os
 import subprocess
+from collections.abc import Mapping
 from pathlib import Path
+
+import numpy as np
 
 
 def source_checkout() -> Path | None:
@@ -101,15 +104,19 @@ def parse_digests(text: str) -> dict[str, str]:
     return {name: digest for digest, _, name in (line.partition("  ") for line in text.splitlines() if line.strip())}
 
 
-def tree_digest(tree) -> str:
-    """sha256 hex digest of a pytree of arrays (e.g. a model's parameters): every leaf's path, dtype, shape and bytes
-    in the order of its flattening, so that two trees have one digest exactly when they are bit-identical."""
-    import jax  # only here: reading and tabulating results imports this module and must not load JAX
-    import numpy as np
-
+def tree_digest(tree: Mapping) -> str:
+    """sha256 hex digest of nested mappings of arrays (e.g. a model's variables): every leaf's path, dtype, shape and
+    bytes in the order of its sorted keys, so that two trees have one digest exactly when they are bit-identical."""
     digest = hashlib.sha256()
-    for path, leaf in jax.tree_util.tree_flatten_with_path(tree)[0]:
-        value = np.ascontiguousarray(np.asarray(leaf))
-        digest.update(f"{jax.tree_util.keystr(path)}:{value.dtype.str}:{value.shape};".encode())
+
+    def add(node, path: str) -> None:
+        if isinstance(node, Mapping):
+            for key in sorted(node):
+                add(node[key], f"{path}/{key}")
+            return
+        value = np.ascontiguousarray(np.asarray(node))
+        digest.update(f"{path}:{value.dtype.str}:{value.shape};".encode())
         digest.update(value.tobytes())
+
+    add(tree, "")
     return digest.hexdigest()

@@ -6,7 +6,7 @@ does not declare (:data:`pushjax.studies.worlds.EFFECTS`: ``tilt``, ``com_offset
 
 In each world the controller (:func:`pushjax.studies.episode.run_episode`: motion capture and the EKF) pushes
 the objects to a sequence of ``first_block + (blocks - 1) * per_block`` goals (:func:`pushjax.control.goals.draw_goals`
-with the world's seed, the objects taking turns) three ways, the **arms** (:data:`ARMS`), on the same goals with the
+with the world's seed, the objects taking turns) four ways, the **arms** (:data:`ARMS`), on the same goals with the
 same testbed draws (paired by goal):
 
 ``adaptive``  records every episode as a push file in the MIT layout (:func:`episode_push_path`); after every block of
@@ -19,7 +19,10 @@ same testbed draws (paired by goal):
 ``plain``     plain Lynch with the nominal pusher friction throughout (no adaptation);
 ``oracle``    the model that knows the world's effect and magnitude (``World.oracle``): ``table_tilt`` with the
               drift force ``tan(tilt) / mu_surface`` downhill, ``cof_offset`` at the moved centre of mass, the true
-              pusher friction, or for the variability its mean ``0.25 exp(sigma^2 / 2)``.
+              pusher friction, or for the variability its mean ``0.25 exp(sigma^2 / 2)``;
+``filtered``  plain Lynch whose pusher friction follows, within each episode, what the EKF infers of it (its latent
+              ``log_mu_scale``, :attr:`pushjax.studies.episode.EpisodeConfig.filtered_friction`), updated before
+              every plan: learning within a push instead of across pushes.
 
 An episode is a function of the world, the goal and the planned-with model, so an arm that plans with the same model as
 another on a goal (``adaptive`` before the loop can run, and wherever the loop's model is plain Lynch's) reuses that
@@ -28,7 +31,8 @@ episode instead of simulating it again.
 Per arm and block: the success rate (:func:`pushjax.control.goals.succeeded`: within 5 mm and 5 degrees), the time to
 goal (the simulated seconds of a success; a failure counts as ``max_time``, as in
 :func:`pushjax.studies.push_to_goal.compare`) and the pusher's path length; for ``adaptive`` what the loop selected
-after each block. The comparison rule, fixed before any run, is :data:`COMPARISON_RULE`.
+after each block. The comparison rules, fixed before any run, are :data:`COMPARISON_RULE` (does the loop close the
+gap) and :data:`FILTER_RULE` (does the filter's friction within an episode beat plain Lynch).
 
 Outputs (:func:`write`): ``results.json``, ``results.md`` and ``time_to_goal.png`` in the work folder; below it
 ``<effect>/world=<seed>/pushes`` (the adaptive arm's push files) and ``<effect>/world=<seed>/loop/block=<b>`` (the
@@ -67,10 +71,11 @@ from pushjax.sim.testbed import REALISTIC, Testbed
 from pushjax.studies import episode
 from pushjax.studies.worlds import EFFECTS, World, draw_world
 
-__all__ = ["ARMS", "AdaptConfig", "COMPARISON_RULE", "GAP_SHARE", "SCALES", "STANDARD_ERRORS", "compare",
+__all__ = ["ARMS", "AdaptConfig", "COMPARISON_RULE", "FILTER_RULE", "GAP_SHARE", "SCALES", "STANDARD_ERRORS", "compare",
+           "compare_filtered",
            "episode_push_path", "make_config", "run", "write"]
 
-ARMS = ("adaptive", "plain", "oracle")
+ARMS = ("adaptive", "plain", "oracle", "filtered")
 """The controllers compared on every goal."""
 
 GAP_SHARE = 0.5
@@ -87,6 +92,13 @@ COMPARISON_RULE = (
     f"-{STANDARD_ERRORS:g} standard errors; otherwise (or with one world seed, which gives no standard error) it is "
     f"not decided. This is the project's decision rule (pushjax.stats.decide) on the paired difference -d_w.")
 """The comparison rule (:func:`compare`), committed before any run."""
+FILTER_RULE = (
+    f"Fixed before any run. Per effect, over every block's goals (the filter learns within an episode, whatever the "
+    f"block), paired by goal: for every world seed w, e_w = mean over the world's goals of (t_filtered - t_plain), t "
+    f"the time to goal in s (a failed goal counts as max_time). Planning with the filter's friction helps when mean_w "
+    f"e_w < -{STANDARD_ERRORS:g} standard errors of that mean over world seeds, hurts when it is > "
+    f"+{STANDARD_ERRORS:g}, else (or with one world seed) not decided: pushjax.stats.decide on e_w.")
+"""The rule of :func:`compare_filtered`, committed before any run."""
 
 EPISODE_FOLDER = "episode={:04d}"
 """The folder of an episode's push file below its object's folder: one push sequence per episode
@@ -252,9 +264,11 @@ def _write_record(path: Path, record: dict) -> dict:
     return json.loads(text)
 
 
-def _episode_inputs(config: AdaptConfig, world: World, task: goals.Goal, spec: AugmentedModel) -> dict:
-    """Everything an episode is a function of (the world, the goal, the planned-with model, the settings)."""
-    return {"effect": world.effect, "world": world.seed, "magnitude": world.magnitude,
+def _episode_inputs(config: AdaptConfig, world: World, task: goals.Goal, spec: AugmentedModel,
+                    filtered_friction: bool = False) -> dict:
+    """Everything an episode is a function of (the world, the goal, the planned-with model and whether its friction
+    follows the filter, the settings)."""
+    return {**({"filtered_friction": True} if filtered_friction else {}), "effect": world.effect, "world": world.seed, "magnitude": world.magnitude,
             "testbed": world.testbed.to_dict(), "effects": repr(world.effects[task.obj]), "object": task.obj,
             "index": task.index, "start": [float(value) for value in task.start],
             "goal": [float(value) for value in task.goal], "model": spec.as_dict(),
@@ -339,8 +353,9 @@ class _WorldRun:
         """The row of `arm` on goal `number` (`task`), read back or simulated (its record, and the adaptive arm's push
         file, written)."""
         config, world, counts = self.config, self.world, self.tally.counts
-        spec = {"adaptive": self.adaptive or self.plain, "plain": self.plain, "oracle": world.oracle[task.obj]}[arm]
-        inputs = _episode_inputs(config, world, task, spec)
+        spec = {"adaptive": self.adaptive or self.plain, "plain": self.plain, "oracle": world.oracle[task.obj],
+                "filtered": self.plain}[arm]
+        inputs = _episode_inputs(config, world, task, spec, filtered_friction=arm == "filtered")
         key = _digest(inputs)
         path = self.folder / EPISODE_RECORD.format(number, arm)
         push_path = (episode_push_path(self.data_dir, config.surface, task.obj, number, config.controller.speed_limit)
@@ -354,7 +369,8 @@ class _WorldRun:
             if key not in (self.outcomes if push_path is None else self.recordings):
                 model = make_model(task.obj, mu=spec.mu, effects=spec.effects, params=spec.params)
                 setup = episode.EpisodeConfig(max_time=config.max_time, surface=config.surface,
-                                              testbed=world.testbed, effects=world.effects[task.obj])
+                                              testbed=world.testbed, effects=world.effects[task.obj],
+                                              filtered_friction=arm == "filtered")
                 began = time.perf_counter()
                 self.recordings[key] = episode.run_episode(mpc, model, config.controller, task, seed=world.seed,
                                                            setup=setup)
@@ -414,7 +430,8 @@ def run(config: AdaptConfig, workdir: str | Path) -> dict:
       one row per arm and goal (``effect, world, arm, block, episode, object, index, success, time_to_goal_s, time_s,
       position_error_mm, yaw_error_deg, path_length_m, stop, plans, repositions, model``), ``loop`` one row per world
       and block (``effect, world, block, pushes, ran, selected, model, reason``: what the next block plans with and
-      why), ``rows`` per effect, arm and block (:func:`_block_rows`), ``comparison`` per effect (:func:`compare`).
+      why), ``rows`` per effect, arm and block (:func:`_block_rows`), ``comparison`` per effect (:func:`compare`),
+      ``filter_rule`` and ``filter_comparison`` per effect (:func:`compare_filtered`).
     """
     workdir = Path(workdir)
     episodes, loops, worlds = [], [], []
@@ -435,7 +452,10 @@ def run(config: AdaptConfig, workdir: str | Path) -> dict:
     results = {"study": "adapt", "settings": config.as_dict(), "comparison_rule": COMPARISON_RULE, "worlds": worlds,
                "episodes": episodes, "loop": loops, "rows": _block_rows(episodes),
                "comparison": {effect: compare([row for row in episodes if row["effect"] == effect],
-                                              config.blocks - 1) for effect in config.effects}}
+                                              config.blocks - 1) for effect in config.effects},
+               "filter_rule": FILTER_RULE,
+               "filter_comparison": {effect: compare_filtered([row for row in episodes if row["effect"] == effect])
+                                     for effect in config.effects}}
     return outputs.compact(results)
 
 
@@ -512,7 +532,7 @@ def compare(episodes: Sequence[dict], block: int) -> dict:
              if row["block"] == block}
     goals_by_world = {}
     for world, arm, obj, index in times:
-        if arm == "plain" and all((world, other, obj, index) in times for other in ARMS):
+        if arm == "plain" and all((world, other, obj, index) in times for other in ("adaptive", "oracle")):
             goals_by_world.setdefault(world, []).append((obj, index))
     per_world = {"criterion": [], "gap": [], "closed": []}
     for world, tasks in sorted(goals_by_world.items()):
@@ -541,6 +561,32 @@ def compare(episodes: Sequence[dict], block: int) -> dict:
             "criterion_s": {"mean": mean, "standard_error": error}, "verdict": verdict, "reason": reason}
 
 
+FILTER_VERDICTS = {stats.HOLDS: "helps", stats.FAILS: "hurts", stats.UNDECIDED: "not decided"}
+""":func:`compare_filtered`'s verdict for each of :func:`pushjax.stats.decide`'s on "the filtered arm beats plain"."""
+
+
+def compare_filtered(episodes: Sequence[dict]) -> dict:
+    """:data:`FILTER_RULE` on one effect's episode rows: ``{"worlds", "goals", "filtered_minus_plain_s": {"mean",
+    "standard_error"}, "verdict", "reason"}`` (s; the standard error None with one world seed; :data:`FILTER_VERDICTS`).
+    """
+    times = {(row["world"], row["arm"], row["object"], row["index"]): row["time_to_goal_s"] for row in episodes}
+    per_world = {}
+    for world, arm, obj, index in sorted(times):
+        if arm == "plain" and (world, "filtered", obj, index) in times:
+            per_world.setdefault(world, []).append(times[(world, "filtered", obj, index)] - times[(world, arm, obj,
+                                                                                                   index)])
+    if not per_world:
+        return {"worlds": 0, "goals": 0, "verdict": FILTER_VERDICTS[stats.UNDECIDED],
+                "reason": "no goal was pushed by both the plain and the filtered arm"}
+    mean, error = _mean_and_error([float(np.mean(differences)) for differences in per_world.values()])
+    verdict = FILTER_VERDICTS[stats.decide(mean, error)]
+    reason = ("one world seed: no standard error over world seeds" if error is None else
+              f"the difference is {abs(mean) / error:.1f} standard errors from zero" if error > 0 else
+              "the difference is the same in every world")
+    return {"worlds": len(per_world), "goals": sum(map(len, per_world.values())),
+            "filtered_minus_plain_s": {"mean": mean, "standard_error": error}, "verdict": verdict, "reason": reason}
+
+
 def _format(value: float | None, spec: str, missing: str = "n/a") -> str:
     return missing if value is None else format(value, spec)
 
@@ -564,6 +610,13 @@ def _markdown(results: dict) -> str:
                       f"{_format(criterion['mean'], '+.2f')} ± {_format(criterion['standard_error'], '.2f')} s, gap "
                       f"closed {_format(comparison.get('gap_closed_share'), '.0%')}: **{comparison['verdict']}** "
                       f"({comparison['reason']})", ""]
+        filtered = results["filter_comparison"][effect]
+        difference = filtered.get("filtered_minus_plain_s", {"mean": None, "standard_error": None})
+        lines += [f"Planning with the filter's friction within each episode ({filtered['goals']} goals, "
+                  f"{filtered['worlds']} worlds): filtered − plain {_format(difference['mean'], '+.2f')} ± "
+                  f"{_format(difference['standard_error'], '.2f')} s: **{filtered['verdict']}** ({filtered['reason']})",
+                  ""]
+    lines += [results["filter_rule"], ""]
     return "\n".join(lines)
 
 

@@ -73,6 +73,8 @@ class EpisodeConfig:
       surface: surface name.
       testbed: the testbed profile (realistic unless :data:`pushjax.sim.testbed.IDEAL` is asked for).
       effects: the simulated world's effects (:class:`pushjax.sim.effects.Effects`).
+      filtered_friction: plan with the pusher friction the EKF infers as it goes (the planned-with model's times
+        ``exp`` of the filter's ``log_mu_scale``), updated before every plan, instead of the model's own.
     """
 
     max_time: float = 60.0
@@ -83,6 +85,7 @@ class EpisodeConfig:
     surface: str = "abs"
     testbed: Testbed = REALISTIC
     effects: Effects = Effects()
+    filtered_friction: bool = False
 
 
 @dataclasses.dataclass(frozen=True)
@@ -309,6 +312,12 @@ def _first_belief(testbed: _Testbed, model: PlanningModel, start: np.ndarray):
     return mean, cov
 
 
+def _with_filtered_friction(model: PlanningModel, mean) -> PlanningModel:
+    """`model` with the pusher friction of the filter's belief `mean` [5] (its ``log_mu_scale`` on the model's)."""
+    scale = jnp.exp(jnp.asarray(mean)[models.STATE_NAMES.index("log_mu_scale")])
+    return model.replace(mu=(model.mu * scale).astype(model.mu.dtype))
+
+
 def _targets(command: Command, commanded: np.ndarray, config, samples_per_period: int) -> np.ndarray:
     """The 4 ms pusher targets of `command` from the commanded position `commanded` [2]: the detour of a
     reposition at the speed limit, else the plan's first ``config.replan_steps`` increments."""
@@ -387,7 +396,8 @@ def run_episode(controller: Controller, model: PlanningModel, config: mpc.Contro
             stop = "reached"
             break
         commanded = testbed.episode.pusher.copy()
-        state, command = controller.replan(config, model, state, jnp.asarray(estimate, jnp.float32),
+        planned = _with_filtered_friction(model, mean) if setup.filtered_friction else model
+        state, command = controller.replan(config, planned, state, jnp.asarray(estimate, jnp.float32),
                                            jnp.asarray(commanded, jnp.float32), goal_array)
         plans += 1
         command = jax.device_get(command)

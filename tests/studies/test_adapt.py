@@ -1,4 +1,4 @@
-"""``python -m experiments.adapt --scale=smoke`` end to end (the rows of the three arms by block, the figure, the
+"""``python -m experiments.adapt --scale=smoke`` end to end (the rows of the arms by block, the figure, the
 controller's own pushes in the MIT layout, the loop run on them after the first block and the second block planned
 with its model), a second run over the same work folder (nothing simulated again, the same bytes; an interrupted
 episode simulated again), a bad flag as one line, and the study's parts without simulation: the config's validation
@@ -59,7 +59,7 @@ def test_smoke_run_switches_to_the_loops_model_and_writes_the_arms_by_block(smok
         assert 0 <= row["success_rate"] <= 1 and row["path_length_m"] > 0
         assert 0 < row["time_to_goal_s"] <= config.max_time + 1 and row["time_to_goal_se_s"] is None  # one world
     episodes = results["episodes"]
-    assert len(episodes) == len(config.effects) * config.episodes * len(adapt.ARMS) == 3 * 18
+    assert len(episodes) == len(config.effects) * config.episodes * len(adapt.ARMS) == 4 * 18
     for row in episodes:
         assert row["time_to_goal_s"] == (row["time_s"] if row["success"] else config.max_time)
     by_arm = {arm: {block: [row for row in episodes if row["arm"] == arm and row["block"] == block]
@@ -71,6 +71,17 @@ def test_smoke_run_switches_to_the_loops_model_and_writes_the_arms_by_block(smok
     assert all(row["model"] == {"effects": [], "pusher_friction": true_mu}
                for block in by_arm["oracle"].values() for row in block)
     assert all(row["model"] == nominal for block in by_arm["plain"].values() for row in block)
+    # The filtered arm plans with plain Lynch whose friction follows the EKF within each episode: on this low-friction
+    # world many of its 6 s pushes are its own, not the plain arm's (where the pusher never slid, the filter has
+    # nothing to move its friction by).
+    filtered, plain = (sum(by_arm[arm].values(), []) for arm in ("filtered", "plain"))
+    assert all(row["model"] == nominal for row in filtered)
+    assert [row["goal"] for row in filtered] == [row["goal"] for row in plain]
+    assert sum(_outcome(one) != _outcome(other) for one, other in zip(filtered, plain, strict=True)) >= len(plain) // 4
+    assert results["filter_rule"] == adapt.FILTER_RULE
+    within = results["filter_comparison"]["pusher_friction"]
+    assert within["goals"] == config.episodes and within["verdict"] == "not decided"
+    assert within["filtered_minus_plain_s"]["standard_error"] is None
 
     # Block 1 (16 episodes): the loop has not run, so the adaptive arm plans with plain Lynch: the plain arm's episodes.
     assert all(row["model"] == nominal for row in by_arm["adaptive"][0])
@@ -129,7 +140,7 @@ def test_a_second_run_reads_back_what_the_first_finished(smoke, monkeypatch, cap
     monkeypatch.setattr(adapt.episode, "run_episode", refuse)
     monkeypatch.setattr(adapt, "close_loop", refuse)
     adapt.write(adapt.run(config, workdir), workdir)
-    assert "adapt: 0 episodes simulated, 54 read back; the loop ran 0 times, 2 read back" in capsys.readouterr().out
+    assert "adapt: 0 episodes simulated, 72 read back; the loop ran 0 times, 2 read back" in capsys.readouterr().out
     assert _outputs(workdir) == first
     assert all(path.stat().st_mtime_ns == mtime for path, mtime in mtimes.items()
                if path.name not in ("results.json", "results.md", "time_to_goal.png"))
@@ -149,7 +160,7 @@ def test_a_second_run_reads_back_what_the_first_finished(smoke, monkeypatch, cap
     monkeypatch.setattr(adapt.episode, "run_episode", counted)
     adapt.write(adapt.run(config, workdir), workdir)
     assert len(calls) == 2
-    assert "adapt: 2 episodes simulated, 52 read back; the loop ran 0 times, 2 read back" in capsys.readouterr().out
+    assert "adapt: 2 episodes simulated, 70 read back; the loop ran 0 times, 2 read back" in capsys.readouterr().out
     assert _outputs(workdir) == first
 
 
@@ -207,3 +218,25 @@ def test_the_comparison_rule():
     for result in (closes, short, within):
         mean, error = result["criterion_s"]["mean"], result["criterion_s"]["standard_error"]
         assert result["verdict"] == adapt.VERDICTS[stats.decide(-mean, error)]
+
+
+def test_the_filter_rule():
+    def rows(times_by_world):  # {world: [(plain, filtered) time per goal]}, goals spread over two blocks
+        return [{"world": world, "arm": arm, "object": "rect1", "index": index, "block": index % 2,
+                 "time_to_goal_s": time}
+                for world, goals in times_by_world.items() for index, times in enumerate(goals)
+                for arm, time in zip(("plain", "filtered"), times)]
+
+    helps = adapt.compare_filtered(rows({w: [(30, 25 + w * 0.5), (20, 17)] for w in range(3)}))
+    assert helps["verdict"] == "helps" and helps["goals"] == 6 and helps["worlds"] == 3
+    hurts = adapt.compare_filtered(rows({w: [(20, 24 + w)] for w in range(3)}))
+    assert hurts["verdict"] == "hurts"
+    mixed = adapt.compare_filtered(rows({0: [(20, 22)], 1: [(20, 19)]}))
+    assert mixed["verdict"] == "not decided" and mixed["filtered_minus_plain_s"]["mean"] == 0.5
+    one = adapt.compare_filtered(rows({0: [(30, 20)]}))
+    assert one["verdict"] == "not decided" and one["reason"] == "one world seed: no standard error over world seeds"
+    assert adapt.compare_filtered(rows({}))["goals"] == 0
+    for result in (helps, hurts, mixed):
+        difference = result["filtered_minus_plain_s"]
+        assert result["verdict"] == adapt.FILTER_VERDICTS[stats.decide(difference["mean"], difference["standard_error"])]
+

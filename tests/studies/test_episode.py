@@ -2,6 +2,7 @@
 the same run; waypoints resampled at the speed limit; the state from a trained hybrid's perception of the depth
 image instead of motion capture."""
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -15,6 +16,7 @@ from pushjax.data import configs as data_configs
 from pushjax.filter import models
 from pushjax.geometry.objects import get_object
 from pushjax.sensing import perception
+from pushjax.sim.effects import Effects
 from pushjax.sim.testbed import REALISTIC
 from pushjax.studies import episode, push_to_goal
 
@@ -49,6 +51,34 @@ def test_a_near_goal_is_reached_on_the_realistic_testbed(episodes):
     speeds = np.linalg.norm(np.diff(result.pusher[:, 1:], axis=0), axis=1) / np.diff(result.pusher[:, 0])
     assert speeds.max() < 1.1 * CONFIG.speed_limit
     assert result.path_length > math.hypot(0.05, 0.02)
+
+
+class _Recording:
+    """The MPC controller, recording the pusher friction of the model each plan is made with."""
+
+    def __init__(self):
+        self.mu = []
+
+    def init(self, config, key):
+        return mpc.init(config, key)
+
+    def replan(self, config, planning_model, state, pose, pusher, goal):
+        self.mu.append(float(planning_model.mu))
+        return mpc.replan(config, planning_model, state, pose, pusher, goal)
+
+
+def test_the_filters_friction_is_planned_with_when_asked():
+    # A low pusher friction in the world: the EKF's latent friction moves from the model's 0.25, and each plan is made
+    # with what it infers by then; without the setting every plan uses the model's own.
+    task = goals.Goal("rect1", 0, (0.0, 0.0, 0.0), (0.05, 0.02, 0.3))
+    setup = episode.EpisodeConfig(max_time=6.0, effects=Effects(pusher_friction=0.1))
+    plain, filtered = _Recording(), _Recording()
+    episode.run_episode(plain, model.make_model("rect1"), CONFIG, task, seed=1, setup=setup)
+    episode.run_episode(filtered, model.make_model("rect1"), CONFIG, task, seed=1,
+                        setup=dataclasses.replace(setup, filtered_friction=True))
+    assert plain.mu == pytest.approx([0.25] * len(plain.mu)) and len(plain.mu) >= 5
+    assert filtered.mu[0] == pytest.approx(0.25) and len(set(filtered.mu)) > 3
+    assert filtered.mu[-1] < 0.2  # towards the world's 0.1
 
 
 def test_the_same_seed_gives_the_same_run(episodes):
