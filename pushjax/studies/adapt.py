@@ -53,7 +53,6 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 import tqdm
 
@@ -68,7 +67,7 @@ from pushjax.mit.files import PushParams, push_file_name, write_push
 from pushjax.physics.model_file import AugmentedModel
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION, SURFACE_NAMES
 from pushjax.sim.testbed import REALISTIC, Testbed
-from pushjax.studies import episode
+from pushjax.studies import adapt_report, episode
 from pushjax.studies.worlds import EFFECTS, World, draw_world
 
 __all__ = ["ARMS", "AdaptConfig", "COMPARISON_RULE", "FILTER_RULE", "GAP_SHARE", "SCALES", "STANDARD_ERRORS", "compare",
@@ -587,60 +586,8 @@ def compare_filtered(episodes: Sequence[dict]) -> dict:
             "filtered_minus_plain_s": {"mean": mean, "standard_error": error}, "verdict": verdict, "reason": reason}
 
 
-def _format(value: float | None, spec: str, missing: str = "n/a") -> str:
-    return missing if value is None else format(value, spec)
-
-
-def _markdown(results: dict) -> str:
-    lines = ["# Learn while pushing", "", results["comparison_rule"], ""]
-    for effect, comparison in results["comparison"].items():
-        lines += [f"## {effect}", "", "| arm | block | episodes | success | time to goal (s) | path length (m) |",
-                  "|---|---:|---:|---:|---:|---:|"]
-        for row in results["rows"]:
-            if row["effect"] == effect:
-                error = row["time_to_goal_se_s"]
-                spread = "" if error is None else f" ± {error:.1f}"
-                lines.append(f"| {row['arm']} | {row['block'] + 1} | {row['episodes']} | {row['success_rate']:.0%} | "
-                             f"{row['time_to_goal_s']:.1f}{spread} | {row['path_length_m']:.3f} |")
-        lines += ["", "What the adaptive arm plans with after each block:", ""]
-        lines += [f"- world {row['world']}, after block {row['block'] + 1} ({row['pushes']} pushes): {row['reason']}"
-                  for row in results["loop"] if row["effect"] == effect]
-        criterion = comparison.get("criterion_s", {"mean": None, "standard_error": None})
-        lines += ["", f"Last block ({comparison['goals']} goals, {comparison['worlds']} worlds): criterion "
-                      f"{_format(criterion['mean'], '+.2f')} ± {_format(criterion['standard_error'], '.2f')} s, gap "
-                      f"closed {_format(comparison.get('gap_closed_share'), '.0%')}: **{comparison['verdict']}** "
-                      f"({comparison['reason']})", ""]
-        filtered = results["filter_comparison"][effect]
-        difference = filtered.get("filtered_minus_plain_s", {"mean": None, "standard_error": None})
-        lines += [f"Planning with the filter's friction within each episode ({filtered['goals']} goals, "
-                  f"{filtered['worlds']} worlds): filtered − plain {_format(difference['mean'], '+.2f')} ± "
-                  f"{_format(difference['standard_error'], '.2f')} s: **{filtered['verdict']}** ({filtered['reason']})",
-                  ""]
-    lines += [results["filter_rule"], ""]
-    return "\n".join(lines)
-
-
-def _figure(results: dict, path: Path) -> None:
-    effects = list(results["comparison"])
-    figure, axes = plt.subplots(1, len(effects), figsize=(4.5 * len(effects), 3.5), squeeze=False)
-    for axis, effect in zip(axes[0], effects):
-        for arm in ARMS:
-            rows = [row for row in results["rows"] if row["effect"] == effect and row["arm"] == arm]
-            blocks = [row["block"] + 1 for row in rows]
-            errors = [row["time_to_goal_se_s"] or 0.0 for row in rows]
-            axis.errorbar(blocks, [row["time_to_goal_s"] for row in rows], yerr=errors, marker="o", capsize=3,
-                          label=arm)
-        axis.set_title(effect)
-        axis.set_xlabel("block")
-        axis.set_ylabel("time to goal (s; failure = max time)")
-        axis.set_xticks(sorted({row["block"] + 1 for row in results["rows"]}))
-    axes[0][0].legend()
-    figure.tight_layout()
-    figure.savefig(path, dpi=100, metadata={"Software": None})
-    plt.close(figure)
-
-
 def write(results: dict, workdir: str | Path) -> list[Path]:
     """Writes ``results.json``, ``results.md`` and ``time_to_goal.png`` (time to goal by block, per effect and arm)
     to `workdir`; returns their paths."""
-    return outputs.write_results(workdir, results, _markdown(results), "time_to_goal.png", _figure)
+    return outputs.write_results(workdir, results, adapt_report.markdown(results), "time_to_goal.png",
+                                 adapt_report.figure)
