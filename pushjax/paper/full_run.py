@@ -234,7 +234,8 @@ def train_unit(spec: spec_lib.ExperimentSpec, unit: Unit, train_examples: Traini
         "parameters": int(sum(np.size(leaf) for leaf in jax.tree.leaves(state.params))),
         "train_seconds": round(phases.seconds, 1), "eval_seconds": round(time.monotonic() - clock, 1),
         "steps_per_second": phases.steps_per_second, "started": started.isoformat(timespec="seconds"),
-        "device": device_description(), "params_sha256": provenance_lib.tree_digest(train_lib.predictor.checkpoint_variables(state)),
+        "device": device_description(),
+        "params_sha256": provenance_lib.tree_digest(train_lib.predictor.checkpoint_variables(state)),
         **(provenance if provenance is not None else
            ({"commit": commit} if (commit := provenance_lib.git_commit()) else {})),
     })
@@ -245,19 +246,19 @@ def check_dataset(workdir: Path, digests: Mapping[str, str], log: Callable[[str]
     baselines were scored on (`DATASET_DIGESTS`, written with ``baselines.json``; a run whose baselines predate it has
     none, and this says so), logs a line where they differ, and returns the build's digest (the sha256 of its
     `DATASET_DIGESTS` text), which every record names."""
-    text = provenance_lib.digests_text(digests)
+    build = hashlib.sha256(provenance_lib.digests_text(digests).encode()).hexdigest()
     path = workdir / DATASET_DIGESTS
     if not path.exists():
         log(f"{NAME}: {path} is missing (baselines scored before builds were recorded), so this build "
             f"({len(digests)} data files) cannot be compared with theirs; each record names its build by dataset_sha256")
-        return hashlib.sha256(text.encode()).hexdigest()
+        return build
     recorded = provenance_lib.parse_digests(path.read_text())
     differing = sorted(name for name in set(recorded) | set(digests) if recorded.get(name) != digests.get(name))
     if differing:
         log(f"{NAME}: the dataset build read here differs from the one the baselines were scored on ({path}) in "
             f"{len(differing)} of {len(set(recorded) | set(digests))} data files ({', '.join(differing[:3])}"
             f"{', …' if len(differing) > 3 else ''}); each record names its build by dataset_sha256")
-    return hashlib.sha256(text.encode()).hexdigest()
+    return build
 
 
 def device_description() -> dict:
