@@ -8,7 +8,8 @@
 # 2. the continuation rule (pushjax.train.stopping.long_run_continues, committed before the run) on every variant's
 #    three seeds at 75 000 steps (experiments.stopping_audit -> results/data_efficiency_long/continuation/), the
 #    decision kept per variant in continuation/<variant>.txt so that a rerun does not decide again;
-# 3. those variants trained on to 150 000 steps, and the rule's record written again;
+# 3. those variants trained on to 150 000 steps, and the rule's record written again; a variant it continues at
+#    150 000 steps trains on to 300 000 (the run's cap) and the record is written once more;
 # 4. the Table 1 findings decided with the long-trained models beside the criterion's
 #    (experiments.findings --replace_with), written to results/data_efficiency_long/findings.md.
 # Niced; the dataset is rebuilt from its seed when work/data lacks it. Commit results/data_efficiency_long (records
@@ -28,28 +29,44 @@ audit() {
   "$PYTHON" -m experiments.stopping_audit --run="$RUN" --workdir="$RUN/continuation"
 }
 
-train --variants=neural,hybrid,error
-# Each variant is decided once, on its three seeds at 75 000 steps, and the decision kept for the reruns (a variant
-# continued beside another still at 75 000 is not decided again on its longer records).
-continued=""
-for variant in neural hybrid error; do
-  decision="$RUN/continuation/$variant.txt"
-  if [ ! -f "$decision" ]; then
-    audit
-    if "$PYTHON" - "$RUN/continuation/results.json" "$variant" > "$decision.partial" <<'EOF'
+# decide STEPS SUFFIX VARIANT...: the variants (comma-separated) whose three seeds at STEPS the continuation rule
+# continues to twice STEPS. Each variant is decided once, on its three seeds at STEPS, and the decision kept in
+# continuation/<variant><SUFFIX>.txt for the reruns (a variant continued beside another still at STEPS is not decided
+# again on its longer records).
+decide() {
+  local steps=$1 suffix=$2 result="" variant decision
+  shift 2
+  for variant in "$@"; do
+    decision="$RUN/continuation/$variant$suffix.txt"
+    if [ ! -f "$decision" ]; then
+      audit >&2
+      if "$PYTHON" - "$RUN/continuation/results.json" "$variant" "$steps" > "$decision.partial" <<'EOF'
 import json, sys
+steps = int(sys.argv[3])
 rows = [row for row in json.load(open(sys.argv[1]))["continuations"] if row["variant"] == sys.argv[2]]
-if len(rows) != 1 or rows[0]["steps"] != [75000, 75000, 75000]:
-    sys.exit(3)  # not three seeds at 75 000 steps: undecided
-print("continues to 150000" if rows[0]["continues"] else "stops at 75000")
+if len(rows) != 1 or rows[0]["steps"] != [steps] * 3:
+    sys.exit(3)  # not three seeds at STEPS: undecided
+print(f"continues to {2 * steps}" if rows[0]["continues"] else f"stops at {steps}")
 EOF
-    then mv "$decision.partial" "$decision"; else rm -f "$decision.partial"; echo "$variant: undecided"; continue; fi
-  fi
-  if grep -q continues "$decision"; then continued="${continued:+$continued,}$variant"; fi
-done
+      then mv "$decision.partial" "$decision"; else rm -f "$decision.partial"; echo "$variant: undecided at $steps" >&2; continue; fi
+    fi
+    if grep -q continues "$decision"; then result="${result:+$result,}$variant"; fi
+  done
+  echo "$result"
+}
+
+train --variants=neural,hybrid,error
+continued=$(decide 75000 "" neural hybrid error)
 if [ -n "$continued" ]; then
   echo "the continuation rule continues $continued to 150 000 steps ($RUN/continuation/)"
   train --steps=150000 --variants="$continued"
+  # At 150 000 steps the rule is applied again; a variant it continues trains on to 300 000 steps, four times the
+  # paper's budget and as far as this run goes.
+  again=$(decide 150000 .150000 ${continued//,/ })
+  if [ -n "$again" ]; then
+    echo "the continuation rule continues $again to 300 000 steps ($RUN/continuation/)"
+    train --steps=300000 --variants="$again"
+  fi
 fi
 audit
 "$PYTHON" -m experiments.findings --workdirs=results/data_efficiency_full --replace_with="$RUN" \
