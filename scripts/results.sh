@@ -66,5 +66,11 @@ run objects
 run velocities
 share velocities error_velocities train_20/l1/neural train_20/l1/hybrid
 run error_velocities
+# With the long-trained models at the full split (scripts/table1_long_run.sh) the findings are decided both ways,
+# side by side: as the runs above give them and with those models in place of the criterion's.
+long_run=()
+if compgen -G "$published/data_efficiency_long/models/*.json" > /dev/null; then
+  long_run=(--replace_with="$published/data_efficiency_long")
+fi
 "$python" -m experiments.findings --workdirs="$(ls -d "$published"/{data_efficiency,data_efficiency_full,new_pushes,velocities,error_velocities,error_variants,objects} 2>/dev/null | paste -sd,)" \
-  --output="$published/findings.md"
+  --output="$published/findings.md" "${long_run[@]}"

@@ -515,7 +515,8 @@ def side_by_side(before: Sequence[Finding], after: Sequence[Finding], labels: tu
     """Two decisions of the same findings (e.g. on models trained two ways) as one markdown table: each finding's
     verdict under `labels[0]` and `labels[1]`, whether it changed, and the second's evidence."""
     by_key = {finding.key: finding for finding in before}
-    lines = [f"| finding (the paper's) | experiment | {labels[0]} | {labels[1]} | changed | evidence ({labels[1]}) |",
+    lines = [_rule_line(), "",
+             f"| finding (the paper's) | experiment | {labels[0]} | {labels[1]} | changed | evidence ({labels[1]}) |",
              "|---|---|---|---|---|---|"]
     for finding in after:
         old = by_key.get(finding.key)
@@ -525,13 +526,16 @@ def side_by_side(before: Sequence[Finding], after: Sequence[Finding], labels: tu
     return "\n".join(lines)
 
 
+def _rule_line() -> str:
+    """How the tables' verdicts are decided, the first line of each."""
+    return (f"Decided at {stats.DECISION_STANDARD_ERRORS:g} standard errors of the difference (`pushjax.stats.decide`, "
+            "one look per run, comparisons uncorrected); scores are "
+            "the mean of trans. and rot. in % of zero, ± s.e. (sequence bootstrap and seed spread); \"not reached at N\": "
+            f"a finding about the paper's full set (190 k) that does not hold at our largest size N < {FULL_SET_MIN}.")
+
+
 def markdown(findings: Sequence[Finding]) -> str:
     """The findings as a markdown table."""
-    lines = [f"Decided at {stats.DECISION_STANDARD_ERRORS:g} standard errors of the difference (`pushjax.stats.decide`, "
-             "one look per run, comparisons uncorrected); scores are "
-             "the mean of trans. and rot. in % of zero, ± s.e. (sequence bootstrap and seed spread); \"not reached at N\": "
-             f"a finding about the paper's full set (190 k) that does not hold at our largest size N < {FULL_SET_MIN}.",
-             "",
-             "| finding (the paper's) | experiment | on our testbed | evidence |", "|---|---|---|---|"]
+    lines = [_rule_line(), "", "| finding (the paper's) | experiment | on our testbed | evidence |", "|---|---|---|---|"]
     lines += [f"| {f.statement} | {f.experiment} | {f.verdict} | {f.evidence} |" for f in findings]
     return "\n".join(lines)
