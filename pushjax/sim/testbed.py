@@ -67,8 +67,9 @@ motion capture, the pusher–object spread or the friction field, per-object and
 2 points. Scaling the pressure part (added in quadrature) towards the paper's 18.95 % / 35.4 % and comparing
 0.5 and 0.45 over three seeds (which redraw the per-surface and per-object realisations too) gave the spreads
 0.45 / 0.45 (a total log-normal spread of 0.64): ``physics`` at 18.5 % / 36.6 % of ``zero`` averaged over the
-seeds, every seed in its band (0.5: 19.3 % / 38.9 %, rotation out of its band on one seed). Measured with them
-on seed 0 (132 sequences at 20 mm/s, 264 over the velocities): ``physics`` 17.9 ± 1.1 % / 32.2 ± 3.2 % of
+seeds, every seed in its band (0.5: 19.3 % / 38.9 %, rotation out of its band on one seed). Measured with them,
+at the commit that chose them (not recorded; the recorded run of the present code is
+``results/benchmarks/calibration_2026-12-02.md``), on seed 0 (132 sequences at 20 mm/s, 264 over the velocities): ``physics`` 17.9 ± 1.1 % / 32.2 ± 3.2 % of
 ``zero`` (ideal profile: 11.4 % / 19.8 %), ``zero`` 2.98 mm / 1.83° per example (paper 2.95 mm / 1.9°), a third
 of the examples without contact: all in their bands; the translation per example at 10 and 300 mm/s is in its
 band too. Missed: the rotation per example at 10 mm/s (0.97° against 1.4° ± 30 %) and 300 mm/s (9.3° against
