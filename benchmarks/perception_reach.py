@@ -17,6 +17,7 @@ Writes ``results.json`` and ``results.md`` to ``--workdir``: about 10 s on 2 cor
 
 import argparse
 import json
+import sys
 from collections import defaultdict
 from pathlib import Path
 
@@ -87,9 +88,9 @@ def main():
     try:
         sensor = perception.load_data_efficiency(args.model, args.scale)
     except ValueError as error:
-        parser.error(f"--model: {' '.join(str(error).split())}")
+        sys.exit(f"perception_reach.py: --model: {' '.join(str(error).split())}")
     if not args.episodes.is_file():
-        parser.error(f"--episodes: no file {args.episodes} (a push-to-goal run's results.json)")
+        sys.exit(f"perception_reach.py: --episodes: no file {args.episodes} (a push-to-goal run's results.json)")
     steps = np.round(np.arange(-args.extent, args.extent + args.step / 2, args.step), 6)
     grid = grid_errors(sensor, args.objects.split(","), [float(yaw) for yaw in args.yaws.split(",")], steps)
     rings = by_ring(grid)
