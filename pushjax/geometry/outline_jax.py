@@ -40,9 +40,10 @@ bearing) and their vertices, and keeps the window's choice only where it is prov
   is the window's, and inside or outside follows from the side of its nearest point, away from the outline and
   from spikes) and, for a pusher not touching at the start, the radius plus the way the pusher travels before the
   window's first hit (or ``NO_HIT``): no feature outside is reached first;
-* or the path (to ``NO_HIT``) stays farther than the radius from the outline's bounding circle, or from the outer
-  side of a window edge's line that has the whole outline on its inner side (every edge of a convex outline):
-  no contact (the next search starts around the window's nearest edge, or beyond the circle from the bearing).
+* or the path (to ``NO_HIT``) stays farther than the radius from the outline's bounding circle, from the outer
+  side of a window edge's line that has the whole outline on its inner side (every edge of a convex outline), or
+  from the outline by the clearance grid's bound for the pusher's cell (:attr:`Outline.clearance`: a bay of a
+  non-convex outline such as butter's): no contact (the next search starts around the window's nearest edge, or beyond the circle from the bearing).
 
 Elsewhere (contact lost or far, a pusher that jumped, the first step when the guess is off) the full search over
 every feature runs, under ``lax.cond``: one push runs it only when it needs it; under ``jax.vmap`` the batch runs
@@ -371,13 +372,24 @@ def _local(shape: Outline, pusher, motion, r, start) -> tuple[_Choice, jax.Array
     beyond_circle = _norm(pusher - shape.bound_centre) - shape.bound_radius - NO_HIT * _norm(motion) > r + margin
     height = _dot(pusher - a, out) - NO_HIT * jnp.maximum(-_dot(motion, out), 0.0)
     beyond_line = jnp.any((rows[:-1, 11] > 0) & (height > r + margin))
-    far = beyond_circle | beyond_line
+    far = beyond_circle | beyond_line | (_clearance(shape, pusher) - NO_HIT * _norm(motion) > r + margin)
     # The next search starts from the bearing's guess beyond the circle, from the window's nearest edge nearer.
     track = jnp.where(beyond_circle, initial_feature(shape, pusher), nearest)
     none = _Choice(nearest, jnp.array(False), jnp.array(False), nearest, jnp.array(True),
                    jnp.asarray(NO_HIT, t_hit.dtype), track)
     choice = jax.tree_util.tree_map(lambda far_value, value: jnp.where(far, far_value, value), none, choice)
     return choice, ~(far | proven)
+
+
+def _clearance(shape: Outline, pusher) -> jax.Array:
+    """[] the clearance grid's lower bound on the pusher centre's distance to the outline (outside it); -inf off the
+    grid."""
+    cells = shape.clearance.shape[0]
+    corner = shape.bound_centre - shape.bound_radius
+    cell = jnp.floor((pusher - corner) / (2 * shape.bound_radius) * cells).astype(jnp.int32)
+    on_grid = jnp.all((cell >= 0) & (cell < cells))
+    cell = jnp.clip(cell, 0, cells - 1)
+    return jnp.where(on_grid, shape.clearance[cell[0], cell[1]], -jnp.inf)
 
 
 def _one(shape, pusher, motion, r, start) -> _Choice:

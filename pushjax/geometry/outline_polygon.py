@@ -27,6 +27,9 @@ WINDOW = 6
 """Edges on either side of the tracked edge that the local search looks at (13 edges, 14 vertices)."""
 SECTORS = 256
 """Bearings about the outline's bounding circle's centre in :func:`initial_feature`'s table."""
+CLEARANCE_CELLS = 32
+"""Cells per side of :attr:`Outline.clearance`'s grid over the square about the bounding circle (2.5 mm cells for
+butter)."""
 _DISTANCE_TOLERANCE = 1e-12
 """m; as in :mod:`pushjax.geometry.contact`: a start this much farther than r from the outline still touches."""
 
@@ -51,6 +54,9 @@ class Outline(NamedTuple):
       bound_radius: [] largest distance of a vertex from ``bound_centre``.
       sectors: [SECTORS] int32, the edge nearest to a pusher on the outline's outermost point at each bearing
         about ``bound_centre`` (:func:`initial_feature`).
+      clearance: [CLEARANCE_CELLS, CLEARANCE_CELLS] a lower bound on the distance from every point of each cell of
+        the square ``bound_centre ± bound_radius`` (first index along x) to the outline, where that point lies
+        outside the polygon; zero or negative where the cell may reach the outline or lie inside (no bound).
     """
 
     start: jax.Array
@@ -62,6 +68,7 @@ class Outline(NamedTuple):
     bound_centre: jax.Array
     bound_radius: jax.Array
     sectors: jax.Array
+    clearance: jax.Array
 
 
 def outline(obj: PushObject | str, dtype=jnp.float32, ellipse_points: int | None = None,
@@ -98,6 +105,7 @@ def outline(obj: PushObject | str, dtype=jnp.float32, ellipse_points: int | None
     bound_centre = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
     bound_radius = np.max(np.linalg.norm(vertices - bound_centre, axis=-1))
     sectors = _sector_table(vertices, edge, bound_centre)
+    clearance = _clearance_grid(vertices, bound_centre, bound_radius)
     count = len(vertices)
     padding = 0 if pad_to is None else max(pad_to - count, 0)
 
@@ -113,7 +121,7 @@ def outline(obj: PushObject | str, dtype=jnp.float32, ellipse_points: int | None
     ring = np.concatenate([ring, np.repeat(ring[:1], len(floats[0]) - count, axis=0)])
     return Outline(*(jnp.asarray(value, dtype) for value in floats), jnp.asarray(count, jnp.int32),
                    jnp.asarray(ring, dtype), jnp.asarray(bound_centre, dtype), jnp.asarray(bound_radius, dtype),
-                   jnp.asarray(sectors, jnp.int32))
+                   jnp.asarray(sectors, jnp.int32), jnp.asarray(clearance, dtype))
 
 
 def _guards(vertices, edge, outward, window: int = WINDOW, radius: float = PUSHER_RADIUS, chunk: int = 256):
@@ -140,6 +148,20 @@ def _guards(vertices, edge, outward, window: int = WINDOW, radius: float = PUSHE
         height = np.sum((vertices[None, :, :] - vertices[rows, None, :]) * outward[rows, None, :], axis=-1)
         depths[rows] = np.min(np.where((after > window) & (after <= count - window), -height, np.inf), axis=1)
     return centre, radii, depths
+
+
+def _clearance_grid(vertices, centre, radius, cells: int = CLEARANCE_CELLS):
+    """[cells, cells] :attr:`Outline.clearance`: each cell's centre's distance to the outline, less the cell's half
+    diagonal, where that centre lies outside the polygon (every point of the cell then lies outside, at least that
+    far); minus the distance less the half diagonal where it lies inside. float64."""
+    side = 2 * radius / cells
+    coordinates = centre[:, None] - radius + side * (np.arange(cells) + 0.5)[None]
+    x, y = np.meshgrid(coordinates[0], coordinates[1], indexing="ij")
+    points = shapely.points(x.ravel(), y.ravel())
+    polygon = shapely.Polygon(vertices)
+    distance = shapely.distance(polygon.exterior, points)
+    signed = np.where(shapely.contains(polygon, points), -distance, distance)
+    return (signed - side / math.sqrt(2)).reshape(cells, cells)
 
 
 def _sector_table(vertices, edge, centre, sectors: int = SECTORS, radius: float = PUSHER_RADIUS):

@@ -236,3 +236,45 @@ def test_outlines_of_several_objects_vmap_together():
         full = jax.vmap(functools.partial(rollout.rollout, search="full"), in_axes=(None, None, 0, None, 0))(
             outline_jax.outline(name), jnp.zeros(3), paths[k], 0.04, mus[k]).poses
         np.testing.assert_allclose(np.asarray(nested[k]), np.asarray(full), atol=1e-6)
+
+
+@pytest.mark.parametrize("name", ["butter", "ellip3", "rect1", "tri1"])
+def test_clearance_grid_is_a_lower_bound_on_the_distance_outside(name):
+    """Random points in every cell: where the cell's clearance is positive, the point lies outside the polygon and
+    at least that far from its outline."""
+    import shapely
+
+    shape = outline_jax.outline(name, jnp.float64 if jax.config.jax_enable_x64 else jnp.float32)
+    clearance = np.asarray(shape.clearance, np.float64)
+    cells = clearance.shape[0]
+    polygon = shapely.Polygon(np.asarray(shape.start, np.float64)[: int(shape.count)])
+    rng = np.random.default_rng(0)
+    corner = np.asarray(shape.bound_centre, np.float64) - float(shape.bound_radius)
+    side = 2 * float(shape.bound_radius) / cells
+    cell = rng.integers(0, cells, (4000, 2))
+    points = corner + (cell + rng.uniform(0.0, 1.0, (4000, 2))) * side
+    bound = clearance[cell[:, 0], cell[:, 1]]
+    proven = bound > 0
+    distance = shapely.distance(polygon.exterior, shapely.points(points))
+    outside = ~shapely.contains(polygon, shapely.points(points))
+    assert proven.mean() > 0.3  # the grid proves something about most of the square around the object
+    assert np.all(outside[proven]) and np.all(distance[proven] >= bound[proven] - 1e-7)
+    lookup = jax.vmap(outline_jax._clearance, in_axes=(None, 0))(shape, jnp.asarray(points, shape.start.dtype))
+    np.testing.assert_allclose(np.asarray(lookup), bound, rtol=1e-6, atol=1e-9)
+    assert float(outline_jax._clearance(shape, jnp.asarray(corner - side, shape.start.dtype))) == -np.inf
+
+
+def test_a_pusher_in_butters_bay_needs_no_full_search():
+    """butter's notch on its -x side holds a pusher 2 cm from every edge, inside the bounding circle and behind no
+    supporting line: the clearance grid proves that a short push touches nothing (before the grid, every step of
+    the controller's plans there ran the full search), and the contact is the full search's."""
+    shape = outline_jax.outline("butter")
+    pushers = jnp.array([[-0.048, 0.0], [-0.046, 0.004], [-0.047, -0.004]])
+    motions = jnp.array([[0.003, 0.0], [0.002, 0.001], [0.002, -0.002]])
+    features = jax.vmap(outline_jax.initial_feature, in_axes=(None, 0))(shape, pushers)
+    _, needs = _windows(shape, pushers, motions, PUSHER_RADIUS, features)
+    assert not np.any(np.asarray(needs))
+    got, expected = (_contacts(search)(shape, pushers, motions, PUSHER_RADIUS, features) for search in ("local", "full"))
+    for field in outline_jax.Contact._fields[:-1]:
+        np.testing.assert_array_equal(np.asarray(getattr(got, field)), np.asarray(getattr(expected, field)), field)
+    assert not np.any(np.asarray(expected.reachable) & np.asarray(expected.touches))
