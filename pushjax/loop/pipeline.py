@@ -165,14 +165,14 @@ def decide(examples: Examples, settings: LoopConfig = LoopConfig(), seed: int = 
                                           seed, report)
     final = selection.final
     report("fitting the learned error term on each fold")
-    means, stds = [], []
-    for k, (fit_index, select_index) in enumerate(split.folds):
-        fit, select = split.pool.select(fit_index), split.pool.select(select_index)
+
+    def out_of_fold_error_term(k: int) -> tuple[np.ndarray, np.ndarray]:
+        fit, select = (split.pool.select(index) for index in split.folds[k])
         result = final.fits[k]
         term = correction_lib.fit_error_correction(fit, fit_lib.predict([result], fit)[0], settings.correction, seed)
-        mean, std = term(select, fit_lib.predict([result], select)[0])
-        means.append(mean)
-        stds.append(std)
+        return term(select, fit_lib.predict([result], select)[0])
+
+    means, stds = zip(*splits_lib.over_folds(out_of_fold_error_term, range(len(split.folds))), strict=True)
     selection_windows = split.pool.select(split.select_index)
     fallback = metrics.window_errors(np.concatenate(means), selection_windows.target, selection_windows.sequence)
     gains = metrics.sequence_gains(final.errors, [fallback])
