@@ -20,7 +20,10 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import os
 from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from typing import TypeVar
 
 import jax
 import jax.numpy as jnp
@@ -32,8 +35,23 @@ from pushjax.loop.windows import Examples
 from pushjax.physics import effects as effects_lib
 from pushjax.physics.effects import EFFECT_NAMES, EFFECTS, ELLIPSOID_EFFECTS, PushInputs
 
+_Item = TypeVar("_Item")
+_Result = TypeVar("_Result")
+
 MIN_PADDED_SIZE = 256
 """Smallest padded example count (see :func:`padded_size`)."""
+
+
+def side_by_side(function: Callable[[_Item], _Result], items: Sequence[_Item]) -> list[_Result]:
+    """``[function(item) for item in items]`` for independent fits (the cross-fitting folds', the two families'), run
+    side by side in threads (XLA computes outside the GIL, and one fit keeps about one core busy), in order; the same
+    programs on the same inputs, so the same results as one after another."""
+    items = list(items)
+    workers = min(len(items), os.cpu_count() or 1)
+    if workers < 2:
+        return [function(item) for item in items]
+    with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="fit") as pool:
+        return list(pool.map(function, items))
 
 
 def padded_size(count: int) -> int:
@@ -293,10 +311,11 @@ def fit_effects(
                         math.radians(settings.rotation_floor_deg) / scale[1]], np.float32) for scale in scales]
     weights = [np.concatenate([subset, np.zeros(padding, bool)]).astype(np.float32) for subset in used]
     results: list[FitResult | None] = [None] * len(candidates)
-    for exact in (False, True):
+
+    def fit_family(exact: bool) -> None:
         members = [k for k, candidate in enumerate(candidates) if is_exact(candidate) == exact]
         if not members:
-            continue
+            return
         names = _family_names(exact)
         slots = _slots(len(members), len(names), exact)
         group = [candidates[k] for k in members]
@@ -330,6 +349,8 @@ def fit_effects(
                 compute_physical=functools.partial(_physical_with_std, one, masks[slot], batch,
                                                    jnp.asarray(scales[k]), floors[k], sequence, candidates[k], exact),
             )
+
+    side_by_side(fit_family, (False, True))
     return results
 
 

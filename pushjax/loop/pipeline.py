@@ -172,7 +172,7 @@ def decide(examples: Examples, settings: LoopConfig = LoopConfig(), seed: int = 
         term = correction_lib.fit_error_correction(fit, fit_lib.predict([result], fit)[0], settings.correction, seed)
         return term(select, fit_lib.predict([result], select)[0])
 
-    means, stds = zip(*splits_lib.over_folds(out_of_fold_error_term, range(len(split.folds))), strict=True)
+    means, stds = zip(*fit_lib.side_by_side(out_of_fold_error_term, range(len(split.folds))), strict=True)
     selection_windows = split.pool.select(split.select_index)
     fallback = metrics.window_errors(np.concatenate(means), selection_windows.target, selection_windows.sequence)
     gains = metrics.sequence_gains(final.errors, [fallback])

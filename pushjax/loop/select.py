@@ -46,7 +46,7 @@ import numpy as np
 
 from pushjax.loop import fit as fit_lib
 from pushjax.loop import hierarchy, metrics
-from pushjax.loop.splits import Split, over_folds
+from pushjax.loop.splits import Split
 from pushjax.loop.windows import Examples
 from pushjax.physics.effects import EFFECT_NAMES, EFFECTS
 
@@ -283,7 +283,8 @@ def select_effects(
     baseline = folds.evaluate([()], [[None] for _ in folds.fit])[0]
     report(f"fitting {len(effects)} effects")
     sets = [(name,) for name in effects]
-    singles = folds.evaluate(sets, over_folds(lambda fit: fit_lib.fit_effects(sets, fit, settings), folds.fit))
+    singles = folds.evaluate(sets, fit_lib.side_by_side(lambda fit: fit_lib.fit_effects(sets, fit, settings),
+                                                        folds.fit))
     ranking = sorted(singles, key=lambda candidate: candidate.score)
     single_params = [{c.effects[0]: c.fits[k].params[c.effects[0]] for c in singles} for k in range(len(folds.fit))]
 
@@ -343,9 +344,10 @@ def _fit_round(folds: _Folds, current: Candidate, sets: list[tuple[str, ...]], a
                 name: single_params[k][name]} for effects_set, name in zip(sets, additions)]
               for k in range(len(folds.fit))]
     for continuations in range(MAX_CONTINUATIONS + 1):
-        per_fold = over_folds(lambda k: fit_lib.fit_effects(sets + [current.effects], folds.fit[k], settings,
-                                                            initial=starts[k] + [current.fits[k].params]),
-                              range(len(folds.fit)))
+        per_fold = fit_lib.side_by_side(
+            lambda k: fit_lib.fit_effects(sets + [current.effects], folds.fit[k], settings,
+                                          initial=starts[k] + [current.fits[k].params]),
+            range(len(folds.fit)))
         *candidates, continued = folds.evaluate(sets + [current.effects], per_fold)
         incumbent_change = (current.score - continued.score) / max(current.score, np.finfo(float).tiny)
         current = continued

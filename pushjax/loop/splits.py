@@ -15,18 +15,11 @@ its smallest p-value over ``S`` sequences is ``2^-S``, which must be below ``alp
 from __future__ import annotations
 
 import dataclasses
-import os
-from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
-from typing import TypeVar
 
 import numpy as np
 
 from pushjax.loop.metrics import smallest_pvalue
 from pushjax.loop.windows import Examples
-
-_Item = TypeVar("_Item")
-_Result = TypeVar("_Result")
 
 MIN_SEQUENCES = 12
 """Fewest push sequences the loop selects on. Measured (``python benchmarks/close_loop_min_data.py``,
@@ -142,14 +135,3 @@ def split(examples: Examples, n_candidates: int, alpha: float = 0.05, test_fract
     return Split(pool=pool, test=test, folds=folds)
 
 
-
-def over_folds(function: Callable[[_Item], _Result], items: Sequence[_Item]) -> list[_Result]:
-    """``[function(item) for item in items]`` for the folds' independent fits, run side by side in threads (XLA
-    computes outside the GIL, and one fold's fit keeps about one core busy), in order; the same programs on the same
-    inputs, so the same results as one after another."""
-    items = list(items)
-    workers = min(len(items), os.cpu_count() or 1)
-    if workers < 2:
-        return [function(item) for item in items]
-    with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="fold") as pool:
-        return list(pool.map(function, items))

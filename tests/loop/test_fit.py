@@ -2,6 +2,8 @@
 targets: the windows of a recorded data set with targets predicted by a known augmented model."""
 
 import dataclasses
+import os
+import threading
 
 import numpy as np
 import pytest
@@ -152,3 +154,20 @@ def test_predictions_in_chunks_equal_the_model_on_every_window(synthetic):
     for result in (fit.FitResult(effects=tuple(TRUE), params=TRUE, loss=0.0), exact):
         direct = effects_lib.compose(result.effects)(result.params, synthetic.inputs)
         np.testing.assert_allclose(fit.predict([result], synthetic)[0], direct, rtol=1e-5, atol=1e-7)
+
+
+def test_side_by_side_runs_the_fits_at_once_in_order():
+    assert fit.side_by_side(lambda k: k * k, range(5)) == [0, 1, 4, 9, 16]
+    assert fit.side_by_side(lambda k: k, []) == []
+
+    def fails_on_two(k):
+        if k == 2:
+            raise ValueError("fold 2")
+        return k
+
+    with pytest.raises(ValueError, match="fold 2"):
+        fit.side_by_side(fails_on_two, range(4))
+    if (os.cpu_count() or 1) < 2:
+        pytest.skip("one core: the fits run one after another")
+    both = threading.Barrier(2, timeout=30)  # each waits for the other: they must run at the same time
+    assert fit.side_by_side(lambda k: (both.wait(), k)[1], [0, 1]) == [0, 1]

@@ -1,8 +1,5 @@
 """Tests of the fit / select / test roles of push sequences and of the refusal to select on too few."""
 
-import os
-import threading
-
 import numpy as np
 import pytest
 
@@ -56,19 +53,3 @@ def test_too_few_sequences_are_refused_with_the_numbers(examples):
     with pytest.raises(ValueError, match="test_fraction"):
         splits.split(examples, n_candidates=10, test_fraction=0.0)
 
-
-def test_over_folds_runs_the_folds_side_by_side_in_order():
-    assert splits.over_folds(lambda k: k * k, range(5)) == [0, 1, 4, 9, 16]
-    assert splits.over_folds(lambda k: k, []) == []
-
-    def fails_on_two(k):
-        if k == 2:
-            raise ValueError("fold 2")
-        return k
-
-    with pytest.raises(ValueError, match="fold 2"):
-        splits.over_folds(fails_on_two, range(4))
-    if (os.cpu_count() or 1) < 2:
-        pytest.skip("one core: the folds run one after another")
-    both = threading.Barrier(2, timeout=30)  # each fold waits for the other: they must run at the same time
-    assert splits.over_folds(lambda k: (both.wait(), k)[1], [0, 1]) == [0, 1]
