@@ -9,6 +9,8 @@
 # Timings depend on the load: record them on idle cores and say so in BENCHMARKS.md beside the number.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# The measured code is this checkout's (a script under benchmarks/ would otherwise import an installed pushjax).
+export PYTHONPATH="$PWD${PYTHONPATH:+:$PYTHONPATH}"
 if [ $# -lt 2 ]; then
   echo "usage: bash scripts/benchmark_record.sh NAME COMMAND..." >&2
   exit 2
