@@ -2,7 +2,7 @@ r"""Learn while pushing: the controller closes the loop on the pushes it makes, 
 
   python -m experiments.adapt --workdir=work/adapt [--scale=smoke|cpu] [--effect=tilt|com_offset|pusher_friction|
       friction_variability] [--worlds=3] [--blocks=4] [--per_block=6] [--first_block=6] [--max_time=30]
-      [--seed=0]
+      [--seed=0] [--report_only]
 
 A testbed table with an effect the controller's model does not declare (its magnitude drawn per world seed), and a
 sequence of goals pushed four ways on the same goals: ``adaptive`` (the loop, ``pushjax.loop.close_loop``, runs on all
@@ -13,9 +13,13 @@ magnitude) and ``filtered`` (Lynch whose pusher friction follows the EKF's withi
 the loop selected after each block; the comparison rules' verdicts), ``results.md`` and
 ``time_to_goal.png`` to ``--workdir``, the push files, the loop's reports and the finished episodes below it; a run
 over the same ``--workdir`` reads back what an earlier (interrupted) run finished instead of simulating it again.
+``--report_only`` writes ``results.md`` and the figure again from ``--workdir``'s ``results.json`` (a published run's
+tables after a change of the report), simulating nothing.
 """
 
+import json
 import math
+from pathlib import Path
 
 from absl import app, flags
 
@@ -35,6 +39,8 @@ _FIRST_BLOCK = flags.DEFINE_integer("first_block", None, "Episodes in the first 
                                     "runs (default: the scale's; the loop needs 12).")
 _MAX_TIME = flags.DEFINE_float("max_time", None, "Simulated seconds per goal (default: the scale's).")
 _SEED = flags.DEFINE_integer("seed", None, "The first world seed (default: the scale's, 0).")
+_REPORT_ONLY = flags.DEFINE_bool("report_only", False, "Write results.md and the figure again from --workdir's "
+                                 "results.json; simulate nothing.")
 experiments.require_writable_folder("workdir")
 
 
@@ -59,9 +65,15 @@ def main(argv):
                                    first_block=_FIRST_BLOCK.value, max_time=_MAX_TIME.value, seed=_SEED.value)
     except ValueError as error:
         raise app.UsageError(f"--{' '.join(str(error).split())}") from None
-    results = adapt.run(config, _WORKDIR.value)
-    paths = adapt.write(results, _WORKDIR.value)
-    print(paths[1].read_text())
+    if _REPORT_ONLY.value:
+        recorded = Path(_WORKDIR.value) / "results.json"
+        if not recorded.is_file():
+            raise app.UsageError(f"--report_only: no results.json in --workdir {_WORKDIR.value}")
+        results = json.loads(recorded.read_text())
+    else:
+        results = adapt.run(config, _WORKDIR.value)
+    paths = adapt.write(results, _WORKDIR.value, tables_only=_REPORT_ONLY.value)
+    print(next(path for path in paths if path.suffix == ".md").read_text())
     print(f"wrote {', '.join(str(path) for path in paths)}")
 
 

@@ -42,10 +42,21 @@ def write_results(workdir: str | os.PathLike, results: dict, tables: str, figure
     ``workdir`` (created); returns their paths."""
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
-    paths = [workdir / "results.json", workdir / "results.md", workdir / figure_name]
-    paths[0].write_text(json.dumps(_with_provenance(results, workdir), indent=1))
-    paths[1].write_text(tables)
-    draw(results, paths[2])
+    recorded = workdir / "results.json"
+    recorded.write_text(json.dumps(_with_provenance(results, workdir), indent=1))
+    return [recorded, *write_tables(workdir, results, tables, figure_name, draw)]
+
+
+def write_tables(workdir: str | os.PathLike, results: Mapping, tables: str, figure_name: str,
+                 draw: Callable[[dict, Path], None]) -> list[Path]:
+    """Writes ``results.md`` (``tables``) and ``figure_name`` (``draw(results, path)``) to ``workdir`` (created),
+    leaving ``results.json`` and the provenance of the run it records as they are (a published run's tables written
+    again after a change of its report); returns their paths."""
+    workdir = Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    paths = [workdir / "results.md", workdir / figure_name]
+    paths[0].write_text(tables)
+    draw(dict(results), paths[1])
     return paths
 
 

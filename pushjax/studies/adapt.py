@@ -586,8 +586,9 @@ def compare_filtered(episodes: Sequence[dict]) -> dict:
             "filtered_minus_plain_s": {"mean": mean, "standard_error": error}, "verdict": verdict, "reason": reason}
 
 
-def write(results: dict, workdir: str | Path) -> list[Path]:
+def write(results: dict, workdir: str | Path, tables_only: bool = False) -> list[Path]:
     """Writes ``results.json``, ``results.md`` and ``time_to_goal.png`` (time to goal by block, per effect and arm)
-    to `workdir`; returns their paths."""
-    return outputs.write_results(workdir, results, adapt_report.markdown(results), "time_to_goal.png",
-                                 adapt_report.figure)
+    to `workdir`; returns their paths. ``tables_only``: ``results.md`` and the figure alone, from a run's recorded
+    ``results.json`` (left as it is, with its provenance)."""
+    write = outputs.write_tables if tables_only else outputs.write_results
+    return write(workdir, results, adapt_report.markdown(results), "time_to_goal.png", adapt_report.figure)

@@ -18,7 +18,7 @@ from pushjax import stats
 from pushjax.loop import splits
 from pushjax.mit.files import load_push, parse_push_file_name
 from pushjax.sim.surfaces import PUSHER_OBJECT_FRICTION
-from pushjax.studies import adapt, worlds
+from pushjax.studies import adapt, adapt_report, worlds
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 
@@ -112,6 +112,9 @@ def test_smoke_run_switches_to_the_loops_model_and_writes_the_arms_by_block(smok
     assert comparison["reason"] == "one world seed: no standard error over world seeds"
     markdown = (workdir / "results.md").read_text()
     assert "| adaptive | 2 | 2 |" in markdown and "(one world seed: no standard error" in markdown
+    # The loop's model beside the world's truth (the world's drawn friction): the measured friction after block 1.
+    truth = next(line for line in markdown.splitlines() if line.startswith("| 0 | Lynch, μ "))
+    assert truth.split(" | ")[2] == f"Lynch, μ {measured:.3f}" and "(pusher_friction " in truth.split(" | ")[1]
     assert (workdir / "time_to_goal.png").stat().st_size > 5000
     # The controller's own pushes, one folder (and push sequence) per episode, readable as MIT files.
     files = sorted((workdir / "pusher_friction" / "world=0" / "pushes").rglob("*.h5"))
@@ -124,6 +127,13 @@ def test_smoke_run_switches_to_the_loops_model_and_writes_the_arms_by_block(smok
 def _outputs(workdir):
     return {path.relative_to(workdir): path.read_bytes() for path in sorted(workdir.rglob("*"))
             if path.is_file() and not path.name.startswith(".")}
+
+
+def test_the_report_shows_no_share_of_a_gap_that_is_not_there():
+    assert adapt_report._gap_text({"plain_minus_oracle_s": -0.8, "plain_minus_adaptive_s": -0.9,
+                                   "gap_closed_share": 1.125}).endswith("no gap to close (the oracle is not faster than plain)")
+    assert adapt_report._gap_text({"plain_minus_oracle_s": 2.2, "plain_minus_adaptive_s": 1.5,
+                                   "gap_closed_share": 1.5 / 2.2}).endswith("gap closed 68%")
 
 
 def test_a_second_run_reads_back_what_the_first_finished(smoke, monkeypatch, capsys):
@@ -169,6 +179,22 @@ def test_a_bad_flag_is_one_line(tmp_path):
     assert result.returncode == 2
     assert result.stderr.strip().splitlines()[-1].startswith("error: --effect=wind: expected one of tilt,")
     assert "Traceback" not in result.stderr
+
+
+def test_report_only_writes_the_tables_again_and_leaves_the_record(smoke, tmp_path):
+    workdir = tmp_path / "published"
+    workdir.mkdir()
+    recorded = (smoke[0] / "results.json").read_bytes()
+    (workdir / "results.json").write_bytes(recorded)
+    result = _binary("--report_only", f"--workdir={workdir}")
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert (workdir / "results.json").read_bytes() == recorded  # the run's provenance kept
+    assert (workdir / "results.md").read_text() == (smoke[0] / "results.md").read_text()
+    assert (workdir / "time_to_goal.png").stat().st_size > 5000
+    assert sorted(path.name for path in workdir.iterdir()) == ["results.json", "results.md", "time_to_goal.png"]
+    missing = _binary("--report_only", f"--workdir={tmp_path / 'empty'}")
+    assert missing.returncode == 2 and "Traceback" not in missing.stderr
+    assert missing.stderr.strip().splitlines()[-1].startswith("error: --report_only: no results.json in --workdir")
 
 
 def test_the_config_is_validated_and_its_scales_are_defined_once():
