@@ -114,6 +114,8 @@ class Decision:
         pushes' parameters in quadrature, :func:`pushjax.loop.variability.window_spread`) and of the error term's own
         standard deviation for the fallback, from their out-of-fold residuals on the selection windows.
       alpha: the level of the fallback's test.
+      error_term: the learned error term trained on the whole pool on the selected model's predictions (the fallback
+        :func:`measure` reports on the test split), trained beside the folds' own.
     """
 
     split: splits_lib.Split
@@ -129,6 +131,7 @@ class Decision:
     selected_multipliers: np.ndarray
     fallback_multipliers: np.ndarray
     alpha: float
+    error_term: correction_lib.ErrorCorrection
 
     @property
     def fallback_helps(self) -> bool:
@@ -164,15 +167,21 @@ def decide(examples: Examples, settings: LoopConfig = LoopConfig(), seed: int = 
     selection = select_lib.select_effects(split, effects, settings.fit, settings.min_gain, settings.alpha,
                                           seed, report)
     final = selection.final
-    report("fitting the learned error term on each fold")
+    report("fitting the learned error term on each fold and on the pool")
 
-    def out_of_fold_error_term(k: int) -> tuple[np.ndarray, np.ndarray]:
+    def error_term(k: int):
+        """Fold k's out-of-fold (mean, std) on its select windows; for k = the number of folds, the pool's term."""
+        if k == len(split.folds):
+            model = selection.model
+            return correction_lib.fit_error_correction(split.pool, fit_lib.predict([model], split.pool)[0],
+                                                       settings.correction, seed)
         fit, select = (split.pool.select(index) for index in split.folds[k])
         result = final.fits[k]
         term = correction_lib.fit_error_correction(fit, fit_lib.predict([result], fit)[0], settings.correction, seed)
         return term(select, fit_lib.predict([result], select)[0])
 
-    means, stds = zip(*fit_lib.side_by_side(out_of_fold_error_term, range(len(split.folds))), strict=True)
+    *out_of_fold, pool_term = fit_lib.side_by_side(error_term, range(len(split.folds) + 1))
+    means, stds = zip(*out_of_fold, strict=True)
     selection_windows = split.pool.select(split.select_index)
     fallback = metrics.window_errors(np.concatenate(means), selection_windows.target, selection_windows.sequence)
     gains = metrics.sequence_gains(final.errors, [fallback])
@@ -194,7 +203,7 @@ def decide(examples: Examples, settings: LoopConfig = LoopConfig(), seed: int = 
                     diagnosis_before=before, diagnosis_after=after, noise=noise, variability=variability,
                     selected_multipliers=metrics.interval_multipliers(local / selected_std),
                     fallback_multipliers=metrics.interval_multipliers(fallback_z),
-                    alpha=settings.alpha)
+                    alpha=settings.alpha, error_term=pool_term)
 
 
 def measured_split(examples: Examples, settings: LoopConfig = LoopConfig(), seed: int = 0
@@ -291,14 +300,19 @@ def measure(decision: Decision, settings: LoopConfig, seed: int, n_skipped: int 
     split, selection = decision.split, decision.selection
     pool, test = split.pool, split.test
     model = selection.model
-    per_group = hierarchy_lib.hierarchical(pool, model, settings.fit) if model is not None else []
-    shape = shape_lib.limit_surface_shape(
-        shape_lib.measured_twists(pool), pool.wrench, pool.inputs.l, pool.sequence,
-        shape_lib.shape_models(pool, model.params if model is not None else None), settings.n_bootstrap, seed)
-    shape = dataclasses.replace(shape, rim_from_force=shape_lib.rim_from_force(pool, shape))
-    term = correction_lib.fit_error_correction(pool, fit_lib.predict([model], pool)[0], settings.correction, seed)
+
+    def limit_surface_shape() -> shape_lib.LimitSurfaceShape:
+        shape = shape_lib.limit_surface_shape(
+            shape_lib.measured_twists(pool), pool.wrench, pool.inputs.l, pool.sequence,
+            shape_lib.shape_models(pool, model.params if model is not None else None), settings.n_bootstrap, seed)
+        return dataclasses.replace(shape, rim_from_force=shape_lib.rim_from_force(pool, shape))
+
+    def per_group_values() -> list[hierarchy_lib.GroupValues]:
+        return hierarchy_lib.hierarchical(pool, model, settings.fit) if model is not None else []
+
+    per_group, shape = fit_lib.side_by_side(lambda compute: compute(), [per_group_values, limit_surface_shape])
     plain_test, model_test = fit_lib.predict([None, model], test)
-    fallback_mean, fallback_std = term(test, model_test)
+    fallback_mean, fallback_std = decision.error_term(test, model_test)
 
     def measured(prediction) -> report_lib.HeldOutErrors:
         errors = metrics.window_errors(prediction, test.target, test.sequence)
