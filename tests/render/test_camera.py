@@ -63,6 +63,8 @@ def test_default_top_down_view_holds_an_object_and_a_push():
     corners = jnp.array([[sx * half, sy * half, 0.0] for sx in (-1, 1) for sy in (-1, 1)])
     pixels, _ = cam.project(corners, camera)
     assert bool(jnp.all((pixels > 0) & (pixels < 64)))
+    # RESULTS.md's "5.2 mm per pixel" of the 64 x 64 images.
+    assert 1000 / float(cam.pixels_per_metre_at_table(camera)) == pytest.approx(5.2, abs=0.05)
 
 
 def test_free_camera_sits_at_the_papers_pose_and_sees_the_table_centre():
