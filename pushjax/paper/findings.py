@@ -76,7 +76,13 @@ class Comparison:
         return stats.decide(self.difference.value, self.difference.se)
 
     def __str__(self) -> str:
-        return f"{self.label}: {self.difference.value:+.1f} ± {self.difference.se or 0.0:.1f}"
+        """``label: difference ± s.e.`` to one decimal; a difference that is not decided although its rounded numbers
+        are 2 standard errors apart or more (``-0.6 ± 0.3``) also gives their exact ratio (``(1.99 s.e.)``)."""
+        value, se = self.difference.value, self.difference.se or 0.0
+        text = f"{self.label}: {value:+.1f} ± {se:.1f}"
+        if self.verdict == UNDECIDED and se > 0 and abs(round(value, 1)) >= stats.decision_bound(1) * round(se, 1):
+            text += f" ({abs(value) / se:.2f} s.e.)"
+        return text
 
 
 @dataclasses.dataclass(frozen=True)

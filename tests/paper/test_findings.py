@@ -8,7 +8,7 @@ import pytest
 from absl import app
 
 from pushjax import stats
-from pushjax.paper import findings
+from pushjax.paper import findings, statistics
 from tests.paper.conftest import run_binary
 
 
@@ -234,3 +234,13 @@ def test_view_cost_is_paired_on_each_split():
     # differences as independent.
     assert cost["cost"].se == pytest.approx(np.hypot(cost["top_down"].se, cost["free"].se))
     assert cost["cost"].replicates is None
+
+
+@pytest.mark.parametrize("value, se, shown", [
+    (-0.552, 0.278, "neural − hybrid: -0.6 ± 0.3 (1.99 s.e.)"),  # rounds to 2 s.e. but is not decided
+    (-0.62, 0.29, "neural − hybrid: -0.6 ± 0.3"),  # decided: the verdict says so
+    (-0.4, 0.3, "neural − hybrid: -0.4 ± 0.3"),  # clearly not decided
+])
+def test_a_difference_shows_its_ratio_where_rounding_hides_the_verdict(value, se, shown):
+    comparison = findings.Comparison("neural − hybrid", statistics.Estimate(value, se, None))
+    assert str(comparison) == shown
