@@ -12,17 +12,15 @@ The pushes are recorded under ``--data_dir`` (reused when present with the same 
 """
 
 import argparse
-import json
 import math
 from pathlib import Path
 
-import numpy as np
 
 from pushjax import outputs
 from pushjax.loop import variability
 from pushjax.loop.windows import build_examples
 from pushjax.mit.files import iter_pushes
-from pushjax.sim.dataset import RecordingConfig, record_pushes
+from pushjax.sim.dataset import RecordingConfig, drawn_relative_sd, plan_pushes, record_pushes
 from pushjax.sim.testbed import IDEAL, REALISTIC
 
 GOAL = 0.25
@@ -31,14 +29,11 @@ GOAL = 0.25
 
 def measure(folder: Path, testbed, pushes: int, seed: int) -> dict:
     """Records (or reuses) `pushes` pushes in `folder` on `testbed`; the recovered spread beside the drawn one."""
-    record_pushes(folder, ["rect1"], ["pu"], pushes, RecordingConfig(seed=seed, velocities=(20.0,), testbed=testbed),
-                  workers=1, progress=True)
-    recorded = list(iter_pushes(folder))
-    examples, _ = build_examples(recorded)
+    settings = RecordingConfig(seed=seed, velocities=(20.0,), testbed=testbed)
+    record_pushes(folder, ["rect1"], ["pu"], pushes, settings, workers=1, progress=True)
+    examples, _ = build_examples(list(iter_pushes(folder)))
     found = variability.measure(examples)["pusher_friction"]
-    draws = np.array([json.loads(push.attributes["pushjax_testbed_draw"])["pusher_friction_factor"]
-                      for push in recorded if "pushjax_testbed_draw" in push.attributes])
-    drawn = float(draws.std(ddof=1) / draws.mean()) if len(draws) > 1 else 0.0
+    drawn = drawn_relative_sd(plan_pushes(folder, ["rect1"], ["pu"], pushes, settings))
     sigma = testbed.pusher_friction_sigma
     return {"testbed": "ideal" if testbed.ideal else "realistic", "sigma": sigma,
             "profile_relative_sd": math.sqrt(math.exp(sigma ** 2) - 1), "drawn_relative_sd": drawn,

@@ -261,6 +261,14 @@ def job_conditions(job: PushJob) -> PushConditions | None:
                            supports)
 
 
+def drawn_relative_sd(jobs: Sequence[PushJob], draw: str = "pusher_friction_factor") -> float:
+    """Sample relative standard deviation (sd over mean, ddof 1) of one scalar testbed draw
+    (:meth:`pushjax.sim.testbed.PushConditions.draws`'s key ``draw``) over planned pushes; 0 on the ideal testbed or
+    for fewer than two pushes. Read from the plan, so it holds for files that do not declare their draws too."""
+    factors = [conditions.draws()[draw] for job in jobs if (conditions := job_conditions(job)) is not None]
+    return float(np.std(factors, ddof=1) / np.mean(factors)) if len(factors) > 1 else 0.0
+
+
 def simulate_job(job: PushJob) -> Recording:
     """Simulates one planned push, with its tracking noise and testbed draw, without writing it."""
     rng = np.random.default_rng(job.noise_seed)

@@ -33,7 +33,7 @@ Criteria (:func:`judge`):
   rim-loaded pressure: ``limit_surface`` selected with its refitted support pressure moved the injected way
   (:func:`outwardness`); the pusher's friction: the force sensor reads it within :data:`SENSOR_TOLERANCE`; a per-push
   spread of the pusher friction: ``variability.pusher_friction.relative_sd`` within :data:`SPREAD_TOLERANCE` of the
-  spread of the draws the pushes were recorded with;
+  spread of the draws the pushes were recorded with (:func:`drawn_spread`, from the recording plan);
 * **added error**: the plain model's test-split error (``report.json``'s ``baseline``, translation + rotation % of
   zero) on the case, averaged over its data sets, over that on ``clean``, minus 1;
 * goals: power >= :data:`POWER_GOAL` for every case whose added error is >= :data:`ADDED_ERROR_FOR_GOAL`; false
@@ -41,7 +41,7 @@ Criteria (:func:`judge`):
   (``fresh``) every variability case's spread found on >= :data:`POWER_GOAL` of its data sets.
 
 **The archive** (``results/loop_power/<setup>/<case>/seed<k>/``): each analysis's ``report.json`` and ``details.json``
-(the loop's own records) and ``analysis.json`` (the data set's recipe, the draws' spread, the seconds it took and the
+(the loop's own records) and ``analysis.json`` (the data set's recipe, the seconds it took and the
 provenance of the code); the pushes stay in a work folder. :func:`tabulate` builds the set-up's table from the
 archive alone, so ``results/loop_power/<setup>/results.md`` is rebuilt from a clone (``--cached_only``), and the test
 suite checks that it is.
@@ -50,6 +50,7 @@ suite checks that it is.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import math
 import shutil
@@ -65,16 +66,15 @@ from scipy import stats
 from pushjax import outputs, provenance
 from pushjax.geometry import get_object, support
 from pushjax.loop import LoopConfig, close_loop
-from pushjax.mit.files import iter_pushes
 from pushjax.physics.effects import support_pressure
-from pushjax.sim.dataset import RecordingConfig, record_pushes
+from pushjax.sim.dataset import RecordingConfig, drawn_relative_sd, plan_pushes, record_pushes
 from pushjax.sim.effects import Effects
 from pushjax.sim.testbed import IDEAL
 
 __all__ = ["ADDED_ERROR_FOR_GOAL", "CASES", "CLEAN", "CRITERIA", "Case", "FALSE_DISCOVERY_BOUND_GOAL",
            "FALSE_DISCOVERY_GOAL", "PLANS", "POWER_GOAL", "REAL_DIFFERENCES", "SETUPS", "SPREAD_TOLERANCE",
-           "SENSOR_TOLERANCE", "Setup", "analyse", "archived", "found", "judge", "planned_counts", "run", "tabulate",
-           "write"]
+           "SENSOR_TOLERANCE", "Setup", "analyse", "archived", "drawn_spread", "found", "judge", "planned_counts",
+           "rate_interval", "recording_settings", "run", "tabulate", "write"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -219,13 +219,9 @@ def analyse(archive: str | Path, pushes_dir: str | Path, setup: str, case: str, 
     if (folder / "analysis.json").is_file():
         return archived(folder)
     chosen, kind = SETUPS[setup], CASES[case]
-    testbed = IDEAL.with_overrides(kind.testbed)
     pushes = Path(pushes_dir) / setup / case / f"seed{seed}"
     record_pushes(pushes / "pushes", list(chosen.objects), [chosen.surface], chosen.pushes_per_object,
-                  RecordingConfig(seed=seed, velocities=chosen.velocities, effects=Effects.parse(kind.effects),
-                                  declare_effects=False, support=kind.support, testbed=testbed,
-                                  start_poses=kind.start_poses),
-                  workers=1, progress=False)
+                  recording_settings(setup, case, seed), workers=1, progress=False)
     start = time.process_time()
     close_loop(pushes / "pushes", pushes / "loop", LoopConfig(), seed=seed, progress=False)
     seconds = time.process_time() - start
@@ -234,18 +230,31 @@ def analyse(archive: str | Path, pushes_dir: str | Path, setup: str, case: str, 
         shutil.copyfile(pushes / "loop" / name, folder / name)
     record = {"setup": setup, "case": case, "seed": seed, "recipe": dataclasses.asdict(kind),
               "objects": list(chosen.objects), "surface": chosen.surface, "velocities_mm_s": list(chosen.velocities),
-              "pushes_per_object": chosen.pushes_per_object, "drawn_pusher_friction_relative_sd": _drawn_spread(pushes),
+              "pushes_per_object": chosen.pushes_per_object,
               "loop_cpu_seconds": round(seconds, 1),
               "provenance": provenance.write_source_diff(folder, source or provenance.source_state())}
     (folder / "analysis.json").write_text(json.dumps(record, indent=1) + "\n")
     return archived(folder)
 
 
-def _drawn_spread(pushes: Path) -> float:
-    """Relative sd of the pusher-friction factors the testbed drew for the data set's pushes (0 without draws)."""
-    factors = [json.loads(push.attributes["pushjax_testbed_draw"])["pusher_friction_factor"]
-               for push in iter_pushes(pushes / "pushes") if "pushjax_testbed_draw" in push.attributes]
-    return float(np.std(factors, ddof=1) / np.mean(factors)) if len(factors) > 1 else 0.0
+def recording_settings(setup: str, case: str, seed: int) -> RecordingConfig:
+    """How data set ``case`` with ``seed`` of ``setup`` is recorded: its effects undeclared, on the ``ideal`` testbed
+    with the case's overrides."""
+    chosen, kind = SETUPS[setup], CASES[case]
+    return RecordingConfig(seed=seed, velocities=chosen.velocities, effects=Effects.parse(kind.effects),
+                           declare_effects=False, support=kind.support, testbed=IDEAL.with_overrides(kind.testbed),
+                           start_poses=kind.start_poses)
+
+
+@functools.cache
+def drawn_spread(setup: str, case: str, seed: int) -> float:
+    """Relative sd of the pusher-friction factors the testbed draws for the data set's pushes (0 without draws), from
+    the recording plan: the pushes are undeclared, so their files do not carry their draws (the archived analyses
+    by f8889a5 and d2e1a08 store 0 for it in ``analysis.json``, read from those files; nothing reads that field)."""
+    chosen = SETUPS[setup]
+    jobs = plan_pushes(Path("unused"), list(chosen.objects), [chosen.surface], chosen.pushes_per_object,
+                       recording_settings(setup, case, seed))
+    return drawn_relative_sd(jobs)
 
 
 def archived(folder: str | Path) -> dict:
@@ -288,7 +297,7 @@ def found(outcome: Mapping) -> bool | None:
         reading = report["pusher_friction"]["force_sensor"]["value"]
         return reading is not None and abs(reading / Effects.parse(kind.effects).pusher_friction - 1) <= SENSOR_TOLERANCE
     if kind.family == "variability":
-        drawn = analysis["drawn_pusher_friction_relative_sd"]
+        drawn = drawn_spread(analysis["setup"], analysis["case"], analysis["seed"])
         recovered = (report.get("variability") or {}).get("pusher_friction", {}).get("relative_sd")
         return recovered is not None and abs(recovered - drawn) <= SPREAD_TOLERANCE * drawn
     if kind.family == "pressure":
@@ -306,6 +315,22 @@ def upper_bound(count: int, total: int, level: float = 0.95) -> float:
     return 1.0 if count == total else float(stats.beta.ppf(level, count + 1, total - count))
 
 
+def rate_interval(count: int, total: int, level: float = 0.95) -> tuple[float, float]:
+    """Two-sided Clopper-Pearson interval of a rate of ``count`` in ``total``."""
+    tail = (1 - level) / 2
+    low = 0.0 if count == 0 else float(stats.beta.ppf(tail, count, total - count + 1))
+    return low, upper_bound(count, total, 1 - tail)
+
+
+def _spread_row(outcome: Mapping) -> dict:
+    """A variability data set's drawn and recovered relative sd of the pusher friction, with its interval."""
+    analysis = outcome["analysis"]
+    recovered = (outcome["report"].get("variability") or {}).get("pusher_friction") or {}
+    return {"case": analysis["case"], "seed": analysis["seed"],
+            "drawn": drawn_spread(analysis["setup"], analysis["case"], analysis["seed"]),
+            "recovered": recovered.get("relative_sd"), "interval": recovered.get("interval"), "found": found(outcome)}
+
+
 def _seeds(root: Path) -> list[int]:
     return sorted(int(path.name[4:]) for path in root.glob("seed*") if (path / "analysis.json").is_file())
 
@@ -317,7 +342,7 @@ def judge(setup: str, outcomes: Mapping[str, Sequence[Mapping]]) -> dict:
     chosen = SETUPS[setup]
     clean = [plain_score(outcome) for outcome in outcomes.get("clean", [])]
     reference = float(np.mean(clean)) if clean else math.nan
-    rows, met, wrong, wrong_leading_edge, clean_total = [], True, 0, 0, 0
+    rows, spreads, met, wrong, wrong_leading_edge, clean_total = [], [], True, 0, 0, 0
     for case in chosen.cases:
         results = outcomes.get(case, [])
         if not results:
@@ -330,10 +355,13 @@ def judge(setup: str, outcomes: Mapping[str, Sequence[Mapping]]) -> dict:
                                   for outcome in results)
         added = float(np.mean(scores)) / reference - 1
         power = None if case in CLEAN else float(np.mean(hits))
+        if kind.family == "variability":
+            spreads += [_spread_row(outcome) for outcome in results]
         rows.append({"case": case, "support": kind.support, "effects": kind.effects, "testbed": kind.testbed,
                      "start_poses": kind.start_poses, "data_sets": len(results), "seeds": [
                          outcome["analysis"]["seed"] for outcome in results],
                      "plain_score": float(np.mean(scores)), "added_error": added, "power": power,
+                     "power_interval": None if power is None else rate_interval(sum(hits), len(hits)),
                      "beyond_real_differences": beyond, "beyond_leading_edge": beyond_leading_edge, "selections": [_listing(outcome) for outcome in results],
                      "in_goal": case in chosen.goal_cases or not chosen.goal_cases})
         if case not in chosen.goal_cases:
@@ -357,7 +385,7 @@ def judge(setup: str, outcomes: Mapping[str, Sequence[Mapping]]) -> dict:
         met = None
     return {"setup": setup, "rows": rows, "false_discoveries": wrong, "clean_data_sets": clean_total,
             "false_discovery_rate": rate, "false_discovery_upper_bound": bound,
-            "beyond_leading_edge": wrong_leading_edge,
+            "beyond_leading_edge": wrong_leading_edge, "spreads": spreads,
             "goal_met": bool(met) if complete and met is not None else None,
             "analyses": [_analysis_row(outcome) for case in chosen.cases for outcome in outcomes.get(case, [])]
             if not chosen.goal_cases else None,
@@ -424,12 +452,13 @@ def write(results: Mapping, table: str, archive: str | Path) -> list[Path]:
 
 def markdown(results: Mapping) -> str:
     """The table of :func:`judge`'s results."""
-    lines = ["| case | support | testbed effect | start poses | plain model, test % | added error | data sets | found | "
+    lines = ["| case | support | testbed effect | start poses | plain model, test % | added error | data sets | found [95 %] | "
              "anything beyond limit_surface, inertia | ... and leading_edge | selections |",
              "|---|---|---|---|---:|---:|---:|---:|---:|---:|---|"]
     for row in results["rows"]:
         effect = "; ".join(part for part in (row["effects"], row["testbed"]) if part) or "-"
-        power = "-" if row["power"] is None else f"{row['power']:.0%}"
+        power = "-" if row["power"] is None else (f"{row['power']:.0%} [{row['power_interval'][0]:.0%}, "
+                                                  f"{row['power_interval'][1]:.0%}]")
         lines.append(f"| {row['case']}{'' if row['in_goal'] else ' (beside the goal)'} | {row['support']} | {effect} | "
                      f"{row['start_poses']} | {row['plain_score']:.1f} | {row['added_error']:+.0%} | "
                      f"{row['data_sets']} | {power} | {row['beyond_real_differences']} | {row['beyond_leading_edge']} | "
@@ -445,6 +474,13 @@ def markdown(results: Mapping) -> str:
                   "the plain model with the force sensor's pusher friction, `after` the selected model, `fallback` "
                   "the learned error term. No goal: the per-effect table."]
         return "\n".join(lines) + "\n"
+    if results.get("spreads"):
+        lines += ["", "| case | seed | pusher friction's relative sd: drawn | recovered [95 %] | within +-25 % |",
+                  "|---|---:|---:|---|---|"]
+        lines += [f"| {row['case']} | {row['seed']} | {row['drawn']:.3f} | "
+                  + ("-" if row["recovered"] is None else
+                     f"{row['recovered']:.3f} [{row['interval'][0]:.3f}, {row['interval'][1]:.3f}]")
+                  + f" | {row['found']} |" for row in results["spreads"]]
     total = results["clean_data_sets"]
     lines += ["", f"False discoveries on the goal's clean data sets: {results['false_discoveries']} of {total}"
               + (f" ({results['false_discovery_rate']:.1%}; one-sided 95 % upper bound "

@@ -2,6 +2,7 @@
 
 import copy
 import dataclasses
+import math
 from pathlib import Path
 
 import pytest
@@ -11,15 +12,18 @@ from pushjax.studies import loop_power
 ARCHIVE = Path(__file__).resolve().parents[2] / "results" / "loop_power"
 
 
-def _outcome(case: str, selected=("limit_surface",), seed=0, force=0.25, recovered=None, drawn=0.0, rim=0.0,
+def _outcome(case: str, selected=("limit_surface",), seed=0, force=0.25, recovered=None, rim=0.0,
              baseline=(20.0, 30.0)):
-    """An archived analysis of ``case`` holding only the fields the judgement reads."""
+    """An archived analysis of the fresh set-up's ``case`` holding only the fields the judgement reads; ``recovered``:
+    the reported relative sd of the pusher friction as a multiple of the data set's drawn one."""
+    drawn = loop_power.drawn_spread("fresh", case, seed)
     return {
-        "analysis": {"seed": seed, "recipe": dataclasses.asdict(loop_power.CASES[case]), "objects": ["rect2", "ellip1"],
-                     "drawn_pusher_friction_relative_sd": drawn},
+        "analysis": {"setup": "fresh", "case": case, "seed": seed,
+                     "recipe": dataclasses.asdict(loop_power.CASES[case]), "objects": ["rect2", "ellip1"]},
         "report": {"selected": list(selected), "alternatives": {},
                    "pusher_friction": {"force_sensor": {"value": force}},
-                   "variability": {} if recovered is None else {"pusher_friction": {"relative_sd": recovered}},
+                   "variability": {} if recovered is None else {"pusher_friction": {
+                       "relative_sd": recovered * drawn, "interval": [0.0, 2 * recovered * drawn]}},
                    "baseline": {"trans_percent": baseline[0], "rot_percent": baseline[1]}},
         "details": {"selected_params": {"limit_surface": {"rim": {"value": rim}, "feet": {"value": 0.0}}}
                     if "limit_surface" in selected else {}},
@@ -47,9 +51,9 @@ def test_a_real_difference_is_no_false_discovery_and_anything_else_is():
     ("pressure_rim", {"rim": -0.5}, False),
     ("pressure_centre", {"rim": -0.5}, True),
     ("pressure_centre", {"selected": ()}, False),
-    ("variability_s", {"drawn": 0.20, "recovered": 0.24}, True),
-    ("variability_s", {"drawn": 0.20, "recovered": 0.26}, False),
-    ("variability_l", {"drawn": 0.40, "recovered": None}, False),
+    ("variability_s", {"recovered": 1.24}, True),
+    ("variability_s", {"recovered": 0.74}, False),
+    ("variability_l", {"recovered": None}, False),
     ("anisotropy", {"selected": ("anisotropic_friction", "frame_offset")}, True),
     ("tracking_bias", {"selected": ("frame_offset",)}, True),
     ("tracking_yaw_bias", {"selected": ("limit_surface",)}, True),  # outside the library: nothing beyond is right
@@ -62,7 +66,7 @@ def test_found_follows_the_stated_criteria(case, kwargs, expected):
 def _planned(setup="fresh", **changes):
     """Every planned data set of ``setup``, each finding its case's physics, none with a false discovery."""
     right = {"com_offset": {"selected": ("cof_offset",)}, "table_tilt": {"selected": ("table_tilt",)},
-             "pusher_friction": {"force": None}, "pressure": {}, "variability": {"drawn": 0.2, "recovered": 0.2},
+             "pusher_friction": {"force": None}, "pressure": {}, "variability": {"recovered": 1.0},
              "clean": {}}
     outcomes = {}
     for case, count in loop_power.PLANS[setup].items():
@@ -77,6 +81,22 @@ def _planned(setup="fresh", **changes):
     for case, (seed, kwargs) in changes.items():
         outcomes[case][seed] = _outcome(case, seed=seed, **kwargs)
     return outcomes
+
+
+def test_the_drawn_spread_is_the_testbed_draws_of_the_recording_plan():
+    sigma = {"variability_s": 0.2, "variability_l": 0.4}
+    for case, log_sd in sigma.items():
+        drawn = [loop_power.drawn_spread("fresh", case, seed) for seed in range(3)]
+        assert all(abs(value / math.sqrt(math.exp(log_sd ** 2) - 1) - 1) < 0.2 for value in drawn), drawn
+        assert len(set(drawn)) == 3  # each seed its own draws
+    assert loop_power.drawn_spread("fresh", "clean", 0) == 0.0
+
+
+def test_the_rate_interval_is_clopper_pearsons():
+    assert loop_power.rate_interval(6, 6) == pytest.approx((0.5407, 1.0), abs=1e-4)
+    assert loop_power.rate_interval(0, 6) == pytest.approx((0.0, 0.4593), abs=1e-4)
+    low, high = loop_power.rate_interval(3, 6)
+    assert low == pytest.approx(0.1181, abs=1e-4) and high == pytest.approx(0.8819, abs=1e-4)
 
 
 def test_the_goal_is_judged_only_on_the_whole_plan():
@@ -116,7 +136,7 @@ def test_a_missed_effect_fails_the_goal_only_where_it_adds_enough_error():
         weak["table_tilt_s"][seed] = _outcome("table_tilt_s", seed=seed, selected=("limit_surface",) if seed == 0
                                               else ("table_tilt",), baseline=(20.0, 30.0))
     assert loop_power.judge("fresh", weak)["goal_met"] is True
-    spread = _planned(variability_l=(2, {"drawn": 0.4, "recovered": 0.2}))  # variability counts whatever it adds
+    spread = _planned(variability_l=(2, {"recovered": 0.5}))  # variability counts whatever it adds
     assert loop_power.judge("fresh", spread)["goal_met"] is False
 
 
