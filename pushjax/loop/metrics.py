@@ -264,13 +264,13 @@ def noise_floor(target: np.ndarray, sequence: np.ndarray, push: np.ndarray, wind
 
 @dataclasses.dataclass(frozen=True)
 class RandomEffects:
-    """One value estimated on several groups, as a random-effects meta-analysis sees it (DerSimonian-Laird).
+    """One value estimated on several groups, as a random-effects meta-analysis sees it.
 
     Attributes:
       fixed_mean: the inverse-variance weighted mean (one shared value, no spread between groups).
       q: Cochran's Q of the groups about ``fixed_mean``.
       p_value: Q against chi-square with groups - 1 degrees of freedom (small: the groups differ beyond their errors).
-      tau: the between-group standard deviation.
+      tau: the between-group standard deviation (:data:`TAU_ESTIMATORS`).
       tau_interval: (low, high) its Q-profile confidence interval (Viechtbauer 2007): the ``tau`` whose generalised Q,
         ``sum (value - mean(tau))^2 / (std^2 + tau^2)``, equals the chi-square quantiles with groups - 1 degrees of
         freedom; a bound is 0 where Q at ``tau = 0`` is below its quantile (the errors alone explain the groups' spread).
@@ -291,14 +291,28 @@ class RandomEffects:
     shrunk_std: np.ndarray
 
 
-def random_effects(value: np.ndarray, std: np.ndarray, level: float = 0.95) -> RandomEffects:
+TAU_ESTIMATORS = ("dersimonian_laird", "paule_mandel")
+"""How :func:`random_effects` estimates ``tau``: DerSimonian-Laird's moment estimator (one step from the fixed-effect
+weights), or Paule-Mandel's, the ``tau`` whose generalised Q equals its expectation, groups - 1 (DerSimonian & Kacker
+2007). Where the groups' errors differ widely and ``tau`` is large against them, DerSimonian-Laird's falls short of the
+spread and can lie below its own Q-profile interval; Paule-Mandel's always lies within it, and the two agree when
+every group has the same error."""
+
+
+def random_effects(value: np.ndarray, std: np.ndarray, level: float = 0.95,
+                   estimator: str = "dersimonian_laird") -> RandomEffects:
     """Pools [G] group estimates with [G] standard errors (all > 0, G >= 2); see :class:`RandomEffects` (``level``: of
-    ``tau_interval``)."""
+    ``tau_interval``; ``estimator``: one of :data:`TAU_ESTIMATORS`)."""
+    if estimator not in TAU_ESTIMATORS:
+        raise ValueError(f"estimator: expected one of {', '.join(TAU_ESTIMATORS)}, got {estimator!r}")
     value, variance = np.asarray(value, np.float64), np.asarray(std, np.float64) ** 2
     weight = 1.0 / variance
     fixed_mean = float(np.sum(weight * value) / np.sum(weight))
     q = float(np.sum(weight * (value - fixed_mean) ** 2))
-    tau_squared = max(0.0, (q - (len(value) - 1)) / (np.sum(weight) - np.sum(weight ** 2) / np.sum(weight)))
+    if estimator == "dersimonian_laird":
+        tau_squared = max(0.0, (q - (len(value) - 1)) / (np.sum(weight) - np.sum(weight ** 2) / np.sum(weight)))
+    else:
+        tau_squared = _q_root(value, variance, len(value) - 1)
     random_weight = 1.0 / (variance + tau_squared)
     mean = float(np.sum(random_weight * value) / np.sum(random_weight))
     keep = tau_squared / (tau_squared + variance)
@@ -308,24 +322,28 @@ def random_effects(value: np.ndarray, std: np.ndarray, level: float = 0.95) -> R
                          shrunk_std=np.sqrt(keep * variance + (1.0 - keep) ** 2 / np.sum(random_weight)))
 
 
+def _generalised_q(value: np.ndarray, variance: np.ndarray, tau_squared: float) -> float:
+    """``sum (value - mean(tau))^2 / (variance + tau^2)``, ``mean(tau)`` weighted by ``1 / (variance + tau^2)``."""
+    weight = 1.0 / (variance + tau_squared)
+    mean = np.sum(weight * value) / np.sum(weight)
+    return float(np.sum(weight * (value - mean) ** 2))
+
+
+def _q_root(value: np.ndarray, variance: np.ndarray, target: float) -> float:
+    """The ``tau^2 >= 0`` at which the generalised Q falls to ``target`` (0 where it is below it at ``tau = 0``)."""
+    if _generalised_q(value, variance, 0.0) <= target:
+        return 0.0
+    # Q falls from Q(0) towards 0 as tau^2 grows; by tau^2 = 1e4 times the values' own variance plus the errors' it is
+    # below every target that matters.
+    largest = 1e4 * (np.var(value) + np.max(variance)) + 1e-300
+    return float(optimize.brentq(lambda t: _generalised_q(value, variance, t) - target, 0.0, largest))
+
+
 def _tau_interval(value: np.ndarray, variance: np.ndarray, level: float) -> tuple[float, float]:
     """The Q-profile interval of the between-group standard deviation (see :class:`RandomEffects`)."""
-
-    def generalised_q(tau_squared):
-        weight = 1.0 / (variance + tau_squared)
-        mean = np.sum(weight * value) / np.sum(weight)
-        return float(np.sum(weight * (value - mean) ** 2))
-
-    # Q falls from Q(0) towards 0 as tau^2 grows; by tau^2 = 1e4 times the values' own variance plus the errors' it is
-    # below every quantile that matters.
-    largest = 1e4 * (np.var(value) + np.max(variance)) + 1e-300
-    bounds = []
-    for quantile in (stats.chi2.ppf(0.5 + level / 2, len(value) - 1), stats.chi2.ppf(0.5 - level / 2, len(value) - 1)):
-        if generalised_q(0.0) <= quantile:
-            bounds.append(0.0)
-        else:
-            bounds.append(float(np.sqrt(optimize.brentq(lambda t: generalised_q(t) - quantile, 0.0, largest))))
-    return bounds[0], bounds[1]
+    low, high = (float(np.sqrt(_q_root(value, variance, stats.chi2.ppf(quantile, len(value) - 1))))
+                 for quantile in (0.5 + level / 2, 0.5 - level / 2))
+    return low, high
 
 
 COVERAGE_LEVELS = (0.68, 0.95)

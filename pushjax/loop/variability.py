@@ -4,7 +4,10 @@ A parameter read on each push (the pusher–object friction that the force senso
 :func:`pushjax.loop.force.sliding_friction`) scatters for two reasons: the readings' measurement error and a true spread
 of the parameter between pushes. The random-effects model that pools the per-object and per-surface values
 (:mod:`pushjax.loop.hierarchy`, :func:`pushjax.loop.metrics.random_effects`), with the pushes as its groups, tells them
-apart: each reading's standard error is its measurement noise, ``tau`` the true spread, with its Q-profile interval.
+apart: each reading's standard error is its measurement noise, ``tau`` the true spread (Paule-Mandel's estimate, which
+lies within its Q-profile interval: the readings' errors differ by orders of magnitude between pushes, where
+DerSimonian-Laird's estimate falls short of a large spread; :data:`pushjax.loop.metrics.TAU_ESTIMATORS`), with its
+Q-profile interval.
 The spread is reported relative to the population's mean (``relative_sd = tau / mean``), so that it compares with a
 log-normal spread ``sigma`` of the parameter (relative standard deviation ``sqrt(exp(sigma^2) - 1)``, e.g. the testbed's
 ``pusher_friction_sigma``).
@@ -36,7 +39,7 @@ class Variability:
     """The spread of one parameter over the pushes.
 
     Attributes:
-      relative_sd: the true spread between pushes (random-effects ``tau``) over the population's mean.
+      relative_sd: the true spread between pushes (random-effects ``tau``, Paule-Mandel) over the population's mean.
       interval: [low, high] its 95 % Q-profile interval, relative to the mean (low is 0 where the readings' measurement
         errors alone explain their scatter).
       mean: the population's mean (random-effects pooled value).
@@ -66,7 +69,7 @@ def spread(value: np.ndarray, std: np.ndarray, source: str) -> Variability | Non
     if np.count_nonzero(known) < MIN_PUSHES:
         return None
     value, std = value[known], std[known]
-    pooled = metrics.random_effects(value, std)
+    pooled = metrics.random_effects(value, std, estimator="paule_mandel")
     return Variability(relative_sd=pooled.tau / pooled.mean, interval=[bound / pooled.mean for bound in pooled.tau_interval],
                        mean=pooled.mean, mean_std=pooled.mean_std,
                        measurement_relative_sd=float(np.sqrt(np.mean(std ** 2)) / pooled.mean),

@@ -72,6 +72,29 @@ def test_random_effects_pool_agreeing_groups_and_shrink_an_imprecise_one():
     np.testing.assert_allclose(agreeing.shrunk_std, agreeing.mean_std)
 
 
+def test_paule_mandel_recovers_a_large_spread_over_unequal_errors_where_dersimonian_laird_falls_short():
+    # The force sensor's readings on the fresh set-up's variability_l pushes: errors of 0.0006-0.01 under a spread of
+    # about 0.1, the larger readings the less precise (correlation 0.27 with the error's log).
+    rng = np.random.default_rng(0)
+    estimates, outside = {name: [] for name in metrics.TAU_ESTIMATORS}, {name: 0 for name in metrics.TAU_ESTIMATORS}
+    for _ in range(100):
+        z = rng.normal(size=120)
+        std = 0.002 * np.exp(z + 0.7 * rng.normal(size=120))
+        value = 0.28 + 0.1 * z + rng.normal(0, std)
+        for name in metrics.TAU_ESTIMATORS:
+            pooled = metrics.random_effects(value, std, estimator=name)
+            estimates[name].append(pooled.tau)
+            outside[name] += not pooled.tau_interval[0] <= pooled.tau <= pooled.tau_interval[1]
+    assert abs(np.mean(estimates["paule_mandel"]) / 0.1 - 1) < 0.03 and outside["paule_mandel"] == 0
+    assert np.mean(estimates["dersimonian_laird"]) < 0.9 * 0.1 and outside["dersimonian_laird"] > 50
+    # With equal errors the two are the same moment estimate: the values' variance less the error's.
+    value, std = rng.normal(1.0, 0.4, 40), np.full(40, 0.1)
+    taus = [metrics.random_effects(value, std, estimator=name).tau for name in metrics.TAU_ESTIMATORS]
+    np.testing.assert_allclose(taus, np.sqrt(np.var(value, ddof=1) - 0.01), rtol=1e-6)
+    with pytest.raises(ValueError, match="estimator: expected one of dersimonian_laird, paule_mandel, got 'reml'"):
+        metrics.random_effects(value, std, estimator="reml")
+
+
 def test_holm_steps_down_from_the_smallest_p_value():
     rejected, levels = metrics.holm(np.array([0.04, 0.001, 0.015, 0.3]), alpha=0.05)
     np.testing.assert_allclose(levels, [0.05 / 2, 0.05 / 4, 0.05 / 3, 0.05])
