@@ -61,27 +61,32 @@ class Variability:
         return dataclasses.asdict(self)
 
 
-def spread(value: np.ndarray, std: np.ndarray, source: str) -> Variability | None:
+def spread(value: np.ndarray, std: np.ndarray, source: str, estimator: str = "paule_mandel") -> Variability | None:
     """The spread of [P] per-push readings with [P] standard errors (NaN: no reading); None with fewer than
-    :data:`MIN_PUSHES` readings."""
+    :data:`MIN_PUSHES` readings (``estimator``: of ``tau``, :data:`pushjax.loop.metrics.TAU_ESTIMATORS`)."""
     value, std = np.asarray(value, np.float64), np.asarray(std, np.float64)
     known = np.isfinite(value) & np.isfinite(std) & (std > 0)
     if np.count_nonzero(known) < MIN_PUSHES:
         return None
     value, std = value[known], std[known]
-    pooled = metrics.random_effects(value, std, estimator="paule_mandel")
+    pooled = metrics.random_effects(value, std, estimator=estimator)
     return Variability(relative_sd=pooled.tau / pooled.mean, interval=[bound / pooled.mean for bound in pooled.tau_interval],
                        mean=pooled.mean, mean_std=pooled.mean_std,
                        measurement_relative_sd=float(np.sqrt(np.mean(std ** 2)) / pooled.mean),
                        n_pushes=int(len(value)), source=source)
 
 
+def pusher_friction_readings(examples: Examples) -> tuple[np.ndarray, np.ndarray]:
+    """[P] the force sensor's pusher-friction reading of each push of ``examples`` and [P] its standard error (NaN:
+    the push slid too briefly for one), in the order of the pushes' indices."""
+    _, first = np.unique(examples.push, return_index=True)
+    return examples.push_friction[first], examples.push_friction_std[first]
+
+
 def measure(examples: Examples) -> dict[str, Variability]:
     """{parameter: its spread over the pushes of ``examples``}, keyed by the loop's parameter names
     (``pusher_friction``); a parameter with too few readings is left out."""
-    _, first = np.unique(examples.push, return_index=True)
-    found = {"pusher_friction": spread(examples.push_friction[first], examples.push_friction_std[first],
-                                       PUSHER_FRICTION_SOURCE)}
+    found = {"pusher_friction": spread(*pusher_friction_readings(examples), PUSHER_FRICTION_SOURCE)}
     return {name: values for name, values in found.items() if values is not None}
 
 
