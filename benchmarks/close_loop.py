@@ -14,12 +14,17 @@ neighbours.
 With ``--compilation_cache`` the loop uses that persistent compilation cache, as ``experiments.close_loop`` uses its
 default one: run it twice with the same empty folder for a cold and a warm first call.
 
-With ``--data_dir`` the pushes are recorded there (or reused when present).
+With ``--data_dir`` the pushes are recorded there (or reused when present). With ``--profile N`` the loop runs under
+``cProfile`` and the N pushjax functions with the largest cumulative time are printed after the timing (the profiler
+adds a few per cent).
 """
 
 import argparse
+import cProfile
 import json
+import pstats
 import resource
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -45,6 +50,8 @@ def main():
     parser.add_argument("--effects", default="com_offset=0.01,-0.005", help="testbed effects (record_pushes syntax)")
     parser.add_argument("--workers", type=int, default=2, help="recording processes")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--profile", type=int, default=0,
+                        help="print this many pushjax functions by cumulative time (cProfile; 0: no profile)")
     parser.add_argument("--compilation_cache", default="off",
                         help="persistent compilation cache folder (default off: every program compiled here)")
     args = parser.parse_args()
@@ -61,14 +68,23 @@ def main():
                                  progress=True)
         print(f"recorded {len(recorded.written)} pushes ({len(recorded.skipped)} reused) in "
               f"{time.perf_counter() - start:.1f} s")
+        profiler = cProfile.Profile() if args.profile else None
         start, cpu = time.perf_counter(), _cpu_seconds()
+        if profiler:
+            profiler.enable()
         report = close_loop(data_dir, workdir, seed=args.seed).report.as_dict()
+        if profiler:
+            profiler.disable()
         elapsed, cpu = time.perf_counter() - start, _cpu_seconds() - cpu
     pushes = len(recorded.written) + len(recorded.skipped)
     print(json.dumps({key: report[key] for key in ("n_pushes", "baseline", "selected", "after", "noise_floor", "explained")},
                      indent=1))
     print(f"close_loop on {pushes} pushes: {elapsed:.1f} s wall, {cpu:.1f} s CPU (user + system, all threads), "
           f"{compiling():.1f} s compiling")
+    if profiler:
+        print(f"\nthe {args.profile} pushjax functions with the largest cumulative time (cProfile, s):")
+        stats = pstats.Stats(profiler, stream=sys.stdout).sort_stats("cumulative")
+        stats.print_stats("pushjax", args.profile)
 
 
 def _compile_seconds():
