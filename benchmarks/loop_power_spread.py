@@ -41,6 +41,7 @@ def pool(pushes: Path, seed: int):
 
 
 def look(pushes_dir: Path, case: str, seed: int) -> dict:
+    """One variability data set: its drawn spread, the archived estimate and both estimators' on the same readings."""
     chosen = loop_power.SETUPS[SETUP]
     pushes = pushes_dir / SETUP / case / f"seed{seed}" / "pushes"
     record_pushes(pushes, list(chosen.objects), [chosen.surface], chosen.pushes_per_object,

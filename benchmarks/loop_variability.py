@@ -15,7 +15,6 @@ import argparse
 import math
 from pathlib import Path
 
-
 from pushjax import outputs
 from pushjax.loop import variability
 from pushjax.loop.windows import build_examples
