@@ -55,6 +55,8 @@ def main():
     parser.add_argument("--compilation_cache", default="off",
                         help="persistent compilation cache folder (default off: every program compiled here)")
     args = parser.parse_args()
+    if args.profile < 0:
+        parser.error(f"--profile: expected a count of functions >= 0, got {args.profile}")
     compilation_cache.enable(args.compilation_cache)
     compiling = _compile_seconds()
 
