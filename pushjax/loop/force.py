@@ -35,11 +35,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 from pushjax import planar
-from pushjax.geometry import PUSHER_RADIUS, PushObject, annotate
+from pushjax.geometry import PUSHER_RADIUS, ContactAnnotation, PushObject, annotate
 from pushjax.mit.files import Push
 
 SLIDE_LAG = 0.1
@@ -62,22 +63,24 @@ MIN_SEQUENCES = 8
 """Push sequences with an estimate needed before the measurement replaces the nominal coefficient."""
 
 
-def sliding_friction(push: Push, obj: PushObject, noise: np.ndarray) -> tuple[float, float]:
+def sliding_friction(push: Push, obj: PushObject, noise: np.ndarray, touches: Touches | None = None
+                     ) -> tuple[float, float]:
     """The pusher–object friction coefficient of one push from its sliding samples and its standard error.
 
     Args:
       push: a cleaned push (object and tip poses m, rad; wrench [T, 3] fx N, fy N, torque N·m, world axes).
       obj: the pushed object.
       noise: [3] standard deviation of the object pose's tracking noise (x m, y m, yaw rad).
+      touches: ``touches_of(push, obj)`` when the caller has it (the costly part); None: computed here.
 
     Returns:
       (coefficient, standard error) (see the module docstring); (NaN, NaN) with fewer than
       :data:`MIN_SLIDING_SAMPLES` sliding samples, a NaN standard error with fewer than :data:`SLIDE_LAG` of them.
     """
-    lag = _lag(push)
-    if lag == 0 or len(push.time) <= lag:
+    touches = touches or touches_of(push, obj)
+    if touches is None:
         return math.nan, math.nan
-    contact, touching = _touched(push, obj, lag)
+    contact, touching, lag = touches
     pose, tip = push.object, push.tip[:, :2]
     normal = np.asarray(contact.normal)
     arm = np.asarray(contact.contact_rel_com)
@@ -117,35 +120,55 @@ def _lag(push: Push) -> int:
     return max(1, round(SLIDE_LAG / dt)) if math.isfinite(dt) else 0
 
 
-def _touched(push: Push, obj: PushObject, lag: int):
-    """The contact of every sample, annotated along the pusher's motion over the next ``lag`` samples (at rest:
-    towards the object's centre), and [T] whether the pusher touches the outline there."""
+class Touches(NamedTuple):
+    """Where the pusher touches the object at every sample of a push (:func:`touches_of`).
+
+    Attributes:
+      contact: the contact of every sample (:func:`pushjax.geometry.annotate`), annotated along the pusher's motion
+        over the next ``lag`` samples (at rest: towards the object's centre).
+      touching: [T] whether the pusher touches the outline.
+      lag: samples in :data:`SLIDE_LAG`.
+    """
+
+    contact: ContactAnnotation
+    touching: np.ndarray
+    lag: int
+
+
+def touches_of(push: Push, obj: PushObject) -> Touches | None:
+    """The contact of every sample of ``push`` and whether the pusher touches there; None for a push no longer than
+    :data:`SLIDE_LAG`."""
+    lag = _lag(push)
+    if lag == 0 or len(push.time) <= lag:
+        return None
     tip, pose = push.tip[:, :2], push.object
     motion = np.concatenate([tip[lag:] - tip[:-lag], np.zeros((lag, 2))])
     towards = pose[:, :2] - tip
     direction = np.where(np.linalg.norm(motion, axis=1, keepdims=True) > 1e-6, motion, towards)
     contact = annotate(obj, pose, tip, direction * (0.01 / np.maximum(np.linalg.norm(direction, axis=1),
                                                                       1e-12))[:, None], radius=PUSHER_RADIUS)
-    return contact, np.asarray(contact.touches) & (np.asarray(contact.first_contact_fraction) < 0.05)
+    return Touches(contact, np.asarray(contact.touches) & (np.asarray(contact.first_contact_fraction) < 0.05), lag)
 
 
-def window_wrenches(push: Push, obj: PushObject, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+def window_wrenches(push: Push, obj: PushObject, starts: np.ndarray, ends: np.ndarray,
+                    touches: Touches | None = None) -> np.ndarray:
     """The mean wrench the pusher applied to the object over each window.
 
     Args:
       push: a cleaned push (wrench [T, 3], the force in N in its first two columns, world axes).
       obj: the pushed object.
       starts, ends: [W] window start and end sample indices.
+      touches: ``touches_of(push, obj)`` when the caller has it; None: computed here.
 
     Returns:
       [W, 3] force along the object's axes (N) and moment about the object's centre of mass (N·m), averaged over
       the window's samples at which the pusher touches and the force is loaded; NaN where there are none.
     """
     wrenches = np.full((len(starts), 3), np.nan)
-    lag = _lag(push)
-    if lag == 0 or len(push.time) <= lag:
+    touches = touches or touches_of(push, obj)
+    if touches is None:
         return wrenches
-    contact, touching = _touched(push, obj, lag)
+    contact, touching, _ = touches
     force = push.wrench[:, :2]
     arm = np.asarray(contact.contact_rel_com)
     moment = arm[:, 0] * force[:, 1] - arm[:, 1] * force[:, 0]

@@ -33,7 +33,7 @@ from pushjax.geometry import (
     limit_surface_ratio,
     support,
 )
-from pushjax.loop.force import sliding_friction, window_wrenches
+from pushjax.loop.force import sliding_friction, touches_of, window_wrenches
 from pushjax.mit.files import Push
 from pushjax.physics.effects import PushInputs
 
@@ -237,7 +237,9 @@ def build_examples(
         stop_time = push.time[stop]
         noise = tracking_noise(push.object)
         speed_until = np.minimum(ends, stop)
-        friction, friction_std = sliding_friction(push, get_object(push.params.shape), noise)
+        obj = get_object(push.params.shape)
+        touches = touches_of(push, obj)
+        friction, friction_std = sliding_friction(push, obj, noise, touches)
         rows[push.params.shape].append(dict(
             pose0=push.object[starts], pose1=push.object[ends], tip0=push.tip[starts, :2],
             motion=push.tip[ends, :2] - push.tip[starts, :2],
@@ -250,7 +252,7 @@ def build_examples(
             tracking_noise=np.broadcast_to(noise, (len(starts), 3)),
             push_friction=np.full(len(starts), friction),
             push_friction_std=np.full(len(starts), friction_std),
-            wrench=window_wrenches(push, get_object(push.params.shape), starts, ends),
+            wrench=window_wrenches(push, obj, starts, ends, touches),
             params=push.params,
         ))
     if n_pushes == 0:

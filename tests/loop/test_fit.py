@@ -171,3 +171,14 @@ def test_side_by_side_runs_the_fits_at_once_in_order():
         pytest.skip("one core: the fits run one after another")
     both = threading.Barrier(2, timeout=30)  # each waits for the other: they must run at the same time
     assert fit.side_by_side(lambda k: (both.wait(), k)[1], [0, 1]) == [0, 1]
+
+
+@pytest.mark.parametrize("count", [1, 255, 256, 257, 1000, 2048, 2049, 2192, 3237, 4096, 4097, 9000, 70000])
+def test_padded_sizes_are_few_and_close_above_the_fine_padding(count):
+    size = fit.padded_size(count)
+    assert size >= max(count, fit.MIN_PADDED_SIZE) and size % fit.MIN_PADDED_SIZE == 0
+    power = 1 << (size - 1).bit_length()
+    if size <= fit.FINE_PADDING_ABOVE:
+        assert size == max(power, fit.MIN_PADDED_SIZE)
+    else:  # one of the 8 sizes between two powers of two: at most an eighth more windows
+        assert size % (power // 16) == 0 and size <= 1.125 * count

@@ -58,3 +58,14 @@ def test_a_turning_object_whose_contact_sticks_is_not_read_as_sliding(tmp_path):
                        for push in pushes])
     assert np.count_nonzero(np.isfinite(values)) >= 3
     np.testing.assert_allclose(values[np.isfinite(values)], 0.6, rtol=0.05)
+
+
+def test_readings_from_shared_touches_equal_their_own(record):
+    # build_examples annotates each push's contacts once and gives them to both readings.
+    push = next(iter(iter_pushes(record("clean"))))
+    obj, noise = get_object(push.params.shape), tracking_noise(push.object)
+    touches = force.touches_of(push, obj)
+    starts = np.arange(0, len(push.time) - 50, 25)
+    assert force.sliding_friction(push, obj, noise, touches) == force.sliding_friction(push, obj, noise)
+    np.testing.assert_array_equal(force.window_wrenches(push, obj, starts, starts + 50, touches),
+                                  force.window_wrenches(push, obj, starts, starts + 50))
