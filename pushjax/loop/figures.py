@@ -1,12 +1,15 @@
-"""The loop report's figures: the residual against the candidate variables and the variables' strengths."""
+"""The loop report's figures: the residual against the candidate variables and the variables' strengths.
+
+Drawn on :class:`matplotlib.figure.Figure` objects, not through pyplot's global state, so that the loop can draw them in
+a thread while it measures (:func:`pushjax.loop.pipeline.close_loop`)."""
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.figure import Figure
 
 from pushjax.loop import diagnose as diagnose_lib
 from pushjax.loop.windows import CATEGORICAL, VARIABLES, Examples
@@ -23,7 +26,8 @@ def residual_figure(path: Path, examples: Examples, prediction: np.ndarray, titl
     rotation = np.degrees(residual[:, 2])
     columns = min(len(variables), 4)
     rows = max(1, math.ceil(len(variables) / max(columns, 1)))
-    figure, axes = plt.subplots(rows, max(columns, 1), figsize=(4 * max(columns, 1), 3 * rows), squeeze=False)
+    figure = Figure(figsize=(4 * max(columns, 1), 3 * rows))
+    axes = figure.subplots(rows, max(columns, 1), squeeze=False)
     for axis in axes.flat[len(variables):]:
         axis.set_visible(False)
     for axis, name in zip(axes.flat, variables):
@@ -45,7 +49,6 @@ def residual_figure(path: Path, examples: Examples, prediction: np.ndarray, titl
     figure.suptitle(title)
     figure.tight_layout()
     figure.savefig(path, dpi=80)
-    plt.close(figure)
 
 
 def strength_figure(path: Path, before: list, after: list) -> None:
@@ -53,7 +56,8 @@ def strength_figure(path: Path, before: list, after: list) -> None:
     names = [d.variable for d in before]
     after_by_name = {d.variable: d.strength for d in after}
     y = np.arange(len(names))
-    figure, axis = plt.subplots(figsize=(7, 0.4 * len(names) + 1.2))
+    figure = Figure(figsize=(7, 0.4 * len(names) + 1.2))
+    axis = figure.subplots()
     axis.barh(y - 0.2, [d.strength for d in before], height=0.4, label="plain model")
     axis.barh(y + 0.2, [after_by_name[name] for name in names], height=0.4, label="after the fix")
     axis.set_yticks(y, names, fontsize=8)
@@ -63,4 +67,3 @@ def strength_figure(path: Path, before: list, after: list) -> None:
     axis.legend(fontsize=8)
     figure.tight_layout()
     figure.savefig(path, dpi=80)
-    plt.close(figure)
