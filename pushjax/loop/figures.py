@@ -1,7 +1,7 @@
 """The loop report's figures: the residual against the candidate variables and the variables' strengths.
 
-Drawn on :class:`matplotlib.figure.Figure` objects, not through pyplot's global state, so that the loop can draw them in
-a thread while it measures (:func:`pushjax.loop.pipeline.close_loop`)."""
+Drawn on :class:`matplotlib.figure.Figure` objects, not through pyplot's global state (a caller's threads and open
+figures are left alone)."""
 
 from __future__ import annotations
 

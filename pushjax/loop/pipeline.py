@@ -11,7 +11,6 @@ import dataclasses
 import math
 import os
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -278,24 +277,19 @@ def close_loop(
         stages.update()
 
         stage("refitting on the pool and measuring on the test split")
-        # The figures need the decision only: drawn beside the measures, which compute mostly outside the GIL.
-        Path(workdir).mkdir(parents=True, exist_ok=True)
-        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="figures") as drawing:
-            figures = drawing.submit(_figures, Path(workdir), decision)
-            report = measure(decision, settings, seed, n_skipped=pushes.n_skipped + build.n_skipped)
-            stages.update()
+        report = measure(decision, settings, seed, n_skipped=pushes.n_skipped + build.n_skipped)
+        stages.update()
 
-            stage("writing the report")
-            details = _details(decision, settings, seed, data_dir,
-                               skipped={**{reason: [p.name for p in paths] for reason, paths in pushes.skipped.items()},
-                                        **build.skipped})
-            model = decision.selection.model
-            selected_model = model_file.AugmentedModel.create(
-                model.effects if model is not None else (), model.params if model is not None else {},
-                float(decision.split.pool.inputs.mu[0]))
-            result = report_lib.LoopResult(report=report, details=details, model=selected_model)
-            report_lib.write(Path(workdir), result)
-            figures.result()
+        stage("writing the report")
+        details = _details(decision, settings, seed, data_dir,
+                           skipped={**{reason: [p.name for p in paths] for reason, paths in pushes.skipped.items()},
+                                    **build.skipped})
+        model = decision.selection.model
+        selected_model = model_file.AugmentedModel.create(
+            model.effects if model is not None else (), model.params if model is not None else {},
+            float(decision.split.pool.inputs.mu[0]))
+        result = report_lib.LoopResult(report=report, details=details, model=selected_model)
+        _write(Path(workdir), result, decision)
         stages.update()
     return result
 
@@ -384,11 +378,12 @@ def _details(decision: Decision, settings: LoopConfig, seed: int, data_dir: Path
     )
 
 
-def _figures(workdir: Path, decision: Decision) -> None:
-    """The report's figures."""
+def _write(workdir: Path, result: report_lib.LoopResult, decision: Decision) -> None:
+    """The report's files and its figures."""
     selection = decision.selection
     figures = workdir / report_lib.FIGURE_DIR
     figures.mkdir(parents=True, exist_ok=True)
+    report_lib.write(workdir, result)
     selection_windows = decision.split.pool.select(decision.split.select_index)
     figures_lib.residual_figure(figures / "residual_baseline.png", selection_windows, selection.baseline.prediction,
                                "Residual of the plain model (median per bin)", decision.variables)
